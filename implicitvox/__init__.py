@@ -1,0 +1,27 @@
+"""implicitvox: robust implicit modeling and voxelization.
+
+Write a solid as an expression in ``x, y, z`` (negative inside), compile it to
+point, interval and gradient evaluators, and voxelize it with an interval
+octree that never misses a voxel the surface passes through.
+
+Examples
+--------
+>>> import implicitvox as iv
+>>> from implicitvox import x, y, z, sqrt
+>>> f = iv.compile(sqrt(x**2 + y**2 + z**2) - 1)
+>>> float(f(0.0, 0.0, 2.0))
+1.0
+"""
+from .expr import Expr, constant, wrap, x, y, z
+from .function import Function, compile
+from .functions import (abs, acos, asin, atan, atan2, clip, cos, exp, floor, hypot, log,
+                        max, min, sin, sqrt, square, tan)
+
+__version__ = "0.1.0"
+
+__all__ = [
+    "Expr", "constant", "wrap", "x", "y", "z",
+    "Function", "compile",
+    "abs", "acos", "asin", "atan", "atan2", "clip", "cos", "exp", "floor", "hypot", "log",
+    "max", "min", "sin", "sqrt", "square", "tan",
+]

@@ -1,0 +1,310 @@
+"""Vectorized interval kernels on ``(lo, hi)`` arrays, rounded outward.
+
+Every kernel takes the endpoint arrays of its arguments and returns the
+endpoint arrays of an interval that holds every value the operation takes
+over the argument boxes *in exact real arithmetic* (Stolte §2, "inclusion
+functions"; the monotone-piece rules are Duff's and Snyder's). The rules:
+
+Rounding
+    After a correctly rounded IEEE 754 operation (``+ - * /``, ``sqrt``) each
+    endpoint moves one ulp outward (:func:`rounding.down`, :func:`rounding.up`).
+    After numpy's transcendentals (``exp log sin cos tan atan asin acos atan2``)
+    it moves :data:`rounding.TRANSCENDENTAL_ULPS` ulps, after ``power`` and
+    ``hypot`` :data:`rounding.POW_ULPS`. ``neg, abs, min, max, floor`` are exact
+    and not widened.
+Tight cases
+    ``square`` and even integer powers clamp at 0 over intervals holding 0;
+    ``sin``/``cos`` return exactly 1 or -1 when the interval holds an interior
+    extremum (found with a conservative slack, so a near miss widens rather
+    than loses the extremum); ``tan`` over an interval holding a pole gives
+    ``(-inf, inf)``; ``atan2`` takes the extreme corner angles of a box that
+    neither holds the origin nor meets the negative x axis (the branch cut) and
+    ``[-pi, pi]`` (rounded out) otherwise; division by an interval holding 0
+    gives the hull ``(-inf, inf)``.
+Domains
+    ``sqrt``, ``log``, ``powr`` (``x >= 0``) and ``asin``, ``acos``
+    (``-1 <= x <= 1``) over an interval partly outside the domain enclose the
+    values on the part inside. Wholly outside, the kernel reports the lane as
+    *empty* (the third returned array) and returns a finite placeholder so the
+    rest of the tape computes without NaN; the evaluator returns the empty
+    interval ``(+inf, -inf)`` for such lanes, which the subdivision reads as
+    "no surface here" (the function is undefined, as numpy's NaN says).
+Infinities and NaN
+    Inputs never hold NaN (the evaluator refuses them). Endpoints may be
+    infinite; ``0 * inf`` and ``inf / inf`` corner products are ignored with
+    ``fmin``/``fmax`` (the other corners bound the range), and a lower endpoint
+    rounded down from ``+inf`` becomes the largest float, so an endpoint
+    computed from such intervals is never NaN.
+
+Examples
+--------
+>>> import numpy as np
+>>> from implicitvox import interval as iv
+>>> lo, hi = iv.i_sin(np.array([0.0]), np.array([3.0]))
+>>> float(lo[0]) < 0.0 < 1.0 == float(hi[0])
+True
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from . import rounding as R
+
+__all__ = [
+    "i_add", "i_sub", "i_mul", "i_div", "i_neg", "i_addc", "i_rsubc", "i_mulc", "i_divc", "i_square", "i_powi", "i_powr",
+    "i_sqrt", "i_abs", "i_exp", "i_log", "i_sin", "i_cos", "i_tan", "i_atan",
+    "i_asin", "i_acos", "i_atan2", "i_hypot", "i_min", "i_max", "i_floor",
+    "mignitude", "magnitude", "PI_UP", "HALF_PI_UP",
+]
+
+T = R.TRANSCENDENTAL_ULPS
+P = R.POW_ULPS
+INF = np.inf
+#: Upper bounds of pi and pi/2 (the doubles ``np.pi`` and ``np.pi/2`` lie below).
+PI_UP = float(np.nextafter(np.pi, INF))
+HALF_PI_UP = float(np.nextafter(np.pi / 2, INF))
+_TWO_PI = 2.0 * np.pi
+
+
+def mignitude(lo, hi):
+    """Smallest ``|v|`` over ``[lo, hi]`` (0 when the interval holds 0)."""
+    return np.maximum(np.maximum(lo, -hi), 0.0)
+
+
+def magnitude(lo, hi):
+    """Largest ``|v|`` over ``[lo, hi]``."""
+    return np.maximum(-lo, hi)
+
+
+# -- the four operations ------------------------------------------------------
+def i_add(alo, ahi, blo, bhi):
+    return R.down(alo + blo), R.up(ahi + bhi)
+
+
+def i_sub(alo, ahi, blo, bhi):
+    return R.down(alo - bhi), R.up(ahi - blo)
+
+
+def i_addc(alo, ahi, c: float):
+    """``a + c`` for an exact constant ``c`` (``a - c`` is ``a + (-c)``)."""
+    return R.down(alo + c), R.up(ahi + c)
+
+
+def i_rsubc(alo, ahi, c: float):
+    """``c - a`` for an exact constant ``c``."""
+    return R.down(c - ahi), R.up(c - alo)
+
+
+def i_mulc(alo, ahi, c: float):
+    """``a * c`` for an exact constant ``c`` (Stolte §2: the order of the bounds
+    follows the sign of ``c``)."""
+    if c >= 0.0:
+        with np.errstate(invalid="ignore"):
+            lo, hi = alo * c, ahi * c
+        if c == 0.0:  # 0 * inf
+            return np.zeros_like(lo), np.zeros_like(hi)
+    else:
+        lo, hi = ahi * c, alo * c
+    return R.down(lo), R.up(hi)
+
+
+def i_divc(alo, ahi, c: float):
+    """``a / c`` for an exact non-zero constant ``c``."""
+    lo, hi = (alo / c, ahi / c) if c > 0.0 else (ahi / c, alo / c)
+    return R.down(lo), R.up(hi)
+
+
+def i_neg(alo, ahi):
+    return -ahi, -alo
+
+
+def _hull4(p1, p2, p3, p4):
+    # fmin/fmax skip the NaN of a 0*inf or inf/inf corner; the others bound the range.
+    lo = np.fmin(np.fmin(p1, p2), np.fmin(p3, p4))
+    hi = np.fmax(np.fmax(p1, p2), np.fmax(p3, p4))
+    return lo, hi
+
+
+def i_mul(alo, ahi, blo, bhi):
+    with np.errstate(invalid="ignore"):
+        lo, hi = _hull4(alo * blo, alo * bhi, ahi * blo, ahi * bhi)
+    if np.isnan(lo).any():  # all four corners 0*inf: a = [0, 0], the product is 0
+        lo, hi = np.nan_to_num(lo, nan=0.0), np.nan_to_num(hi, nan=0.0)
+    return R.down(lo), R.up(hi)
+
+
+def i_div(alo, ahi, blo, bhi):
+    with np.errstate(invalid="ignore", divide="ignore"):
+        lo, hi = _hull4(alo / blo, alo / bhi, ahi / blo, ahi / bhi)
+    holds_zero = (blo <= 0.0) & (bhi >= 0.0)
+    lo = np.where(holds_zero, -INF, R.down(lo))
+    hi = np.where(holds_zero, INF, R.up(hi))
+    return lo, hi
+
+
+# -- powers and roots -----------------------------------------------------------
+def i_square(alo, ahi):
+    mig = mignitude(alo, ahi)
+    mag = magnitude(alo, ahi)
+    mig *= mig
+    mag *= mag
+    return R.down_nonneg(mig), R.up_nonneg(mag)
+
+
+def i_powi(alo, ahi, n: int):
+    """``x ** n`` for an integer ``n`` (negative: the reciprocal of ``x ** -n``)."""
+    if n == 0:
+        return np.ones_like(alo), np.ones_like(ahi)
+    if n == 1:
+        return alo, ahi
+    if n == 2:
+        return i_square(alo, ahi)
+    if n < 0:
+        plo, phi = i_powi(alo, ahi, -n)
+        one = np.ones_like(plo)
+        return i_div(one, one, plo, phi)
+    with np.errstate(over="ignore"):
+        if n % 2 == 0:
+            lo = np.power(mignitude(alo, ahi), n)
+            hi = np.power(magnitude(alo, ahi), n)
+            return R.down_nonneg(lo, P), R.up_nonneg(hi, P)
+        return R.down(np.power(alo, n), P), R.up(np.power(ahi, n), P)
+
+
+def i_powr(alo, ahi, p: float):
+    """``x ** p`` for a real, non-integral ``p``; defined for ``x >= 0``."""
+    empty = ahi < 0.0
+    a = np.maximum(alo, 0.0)
+    b = np.maximum(ahi, 0.0)
+    with np.errstate(over="ignore", divide="ignore"):
+        if p > 0:
+            lo, hi = np.power(a, p), np.power(b, p)
+        else:
+            lo, hi = np.power(b, p), np.power(a, p)
+    return R.down_nonneg(lo, P), R.up_nonneg(hi, P), empty
+
+
+def i_sqrt(alo, ahi):
+    empty = ahi < 0.0
+    lo = np.sqrt(np.maximum(alo, 0.0))
+    hi = np.sqrt(np.maximum(ahi, 0.0))
+    return R.down_nonneg(lo), R.up_nonneg(hi), empty
+
+
+def i_abs(alo, ahi):
+    return mignitude(alo, ahi), magnitude(alo, ahi)
+
+
+def i_hypot(alo, ahi, blo, bhi):
+    lo = np.hypot(mignitude(alo, ahi), mignitude(blo, bhi))
+    hi = np.hypot(magnitude(alo, ahi), magnitude(blo, bhi))
+    return R.down_nonneg(lo, P), R.up_nonneg(hi, P)
+
+
+# -- exponential and logarithm -----------------------------------------------------
+def i_exp(alo, ahi):
+    with np.errstate(over="ignore"):
+        return R.down_nonneg(np.exp(alo), T), R.up_nonneg(np.exp(ahi), T)
+
+
+def i_log(alo, ahi):
+    empty = ahi < 0.0
+    with np.errstate(divide="ignore"):
+        lo = np.log(np.maximum(alo, 0.0))
+        hi = np.log(np.maximum(ahi, 0.0))
+    return R.down(lo, T), R.up(hi, T), empty
+
+
+# -- trigonometry -------------------------------------------------------------------
+def _holds_phase(alo, ahi, period: float, phase: float):
+    """Does ``[alo, ahi]`` hold a point ``t`` with ``t / period - phase`` an integer?
+
+    Conservative: the slack covers the rounding of the division, so a point
+    just outside may count as inside (a wider, still valid interval), never
+    the reverse. Intervals of width >= one period always hold one; beyond
+    about 1e13 periods from 0 every interval is said to hold one.
+    """
+    u_lo = alo / period - phase
+    u_hi = ahi / period - phase
+    slack_lo = 1e-12 * (1.0 + np.abs(u_lo))
+    slack_hi = 1e-12 * (1.0 + np.abs(u_hi))
+    with np.errstate(invalid="ignore"):
+        held = np.floor(u_hi + slack_hi) >= np.ceil(u_lo - slack_lo)
+    return held | ~np.isfinite(u_lo) | ~np.isfinite(u_hi)
+
+
+def _periodic(alo, ahi, f, max_phase: float, min_phase: float):
+    with np.errstate(invalid="ignore"):
+        fa, fb = f(alo), f(ahi)
+    lo = R.down(np.fmin(fa, fb), T)
+    hi = R.up(np.fmax(fa, fb), T)
+    hi = np.where(_holds_phase(alo, ahi, _TWO_PI, max_phase), 1.0, np.minimum(hi, 1.0))
+    lo = np.where(_holds_phase(alo, ahi, _TWO_PI, min_phase), -1.0, np.maximum(lo, -1.0))
+    # sin(inf) is NaN: an infinite endpoint already made both phases "held".
+    return lo, hi
+
+
+def i_sin(alo, ahi):
+    return _periodic(alo, ahi, np.sin, 0.25, 0.75)
+
+
+def i_cos(alo, ahi):
+    return _periodic(alo, ahi, np.cos, 0.0, 0.5)
+
+
+def i_tan(alo, ahi):
+    pole = _holds_phase(alo, ahi, np.pi, 0.5)
+    with np.errstate(invalid="ignore"):
+        lo = R.down(np.tan(alo), T)
+        hi = R.up(np.tan(ahi), T)
+    return np.where(pole, -INF, lo), np.where(pole, INF, hi)
+
+
+def i_atan(alo, ahi):
+    lo = R.down(np.arctan(alo), T)
+    hi = R.up(np.arctan(ahi), T)
+    return np.maximum(lo, -HALF_PI_UP), np.minimum(hi, HALF_PI_UP)
+
+
+def i_asin(alo, ahi):
+    empty = (ahi < -1.0) | (alo > 1.0)
+    a = np.clip(alo, -1.0, 1.0)
+    b = np.clip(ahi, -1.0, 1.0)
+    return R.down(np.arcsin(a), T), R.up(np.arcsin(b), T), empty
+
+
+def i_acos(alo, ahi):
+    empty = (ahi < -1.0) | (alo > 1.0)
+    a = np.clip(alo, -1.0, 1.0)
+    b = np.clip(ahi, -1.0, 1.0)
+    return R.down_nonneg(np.arccos(b), T), R.up_nonneg(np.arccos(a), T), empty
+
+
+def i_atan2(ylo, yhi, xlo, xhi):
+    """``atan2(y, x)`` over the box ``[xlo, xhi] x [ylo, yhi]``.
+
+    Off the origin and the negative x axis the angle is continuous and its
+    extremes over a box are at corners (its level sets are rays from the
+    origin). A box meeting the negative x axis (where numpy's atan2 jumps
+    from pi to -pi, including y = +-0) or holding the origin gets
+    ``[-pi, pi]``.
+    """
+    lo, hi = _hull4(np.arctan2(ylo, xlo), np.arctan2(ylo, xhi),
+                    np.arctan2(yhi, xlo), np.arctan2(yhi, xhi))
+    lo = np.maximum(R.down(lo, T), -PI_UP)
+    hi = np.minimum(R.up(hi, T), PI_UP)
+    full = (xlo <= 0.0) & (ylo <= 0.0) & (yhi >= 0.0)
+    return np.where(full, -PI_UP, lo), np.where(full, PI_UP, hi)
+
+
+# -- exact operations ----------------------------------------------------------------
+def i_min(alo, ahi, blo, bhi):
+    return np.minimum(alo, blo), np.minimum(ahi, bhi)
+
+
+def i_max(alo, ahi, blo, bhi):
+    return np.maximum(alo, blo), np.maximum(ahi, bhi)
+
+
+def i_floor(alo, ahi):
+    return np.floor(alo), np.floor(ahi)

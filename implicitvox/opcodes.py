@@ -1,0 +1,225 @@
+"""The opcode table: one row per operation, read by every evaluator.
+
+Each :class:`Opcode` row carries
+
+* ``point(args, param)`` - numpy values from numpy argument values;
+* ``interval(los, his, param)`` - an outward-rounded enclosure
+  (:mod:`implicitvox.interval`); rows with ``domain=True`` also return a
+  boolean "empty" array (the argument lies wholly outside the domain);
+* ``derivative(vals, grads, out, param)`` - forward-mode rule: the gradient
+  of the result (shape ``(3, n)``) from the argument values and gradients;
+* ``reference(args, param)`` - the exact value with mpmath at the working
+  precision, or ``None`` where the operation is undefined. Tests use it as the
+  oracle; nothing on a hot path calls it.
+
+A new operation is one new row (libfive's ``opcode.hpp`` works the same way).
+
+Examples
+--------
+>>> from implicitvox.opcodes import OPCODES
+>>> OPCODES["sin"].arity
+1
+>>> sorted(name for name, op in OPCODES.items() if op.domain)
+['acos', 'asin', 'log', 'powr', 'sqrt']
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any, Callable
+
+import mpmath
+import numpy as np
+
+from . import interval as I
+
+__all__ = ["Opcode", "OPCODES"]
+
+
+@dataclass(frozen=True)
+class Opcode:
+    """One row of the opcode table (see the module docstring)."""
+
+    name: str
+    arity: int
+    point: Callable[..., Any]
+    interval: Callable[..., Any]
+    derivative: Callable[..., Any]
+    reference: Callable[..., Any]
+    domain: bool = False
+    #: interval kernel exact (no rounding): neg, abs, min, max, floor
+    exact: bool = False
+    #: made by the tape (an operation with an exact constant operand), not the DSL
+    internal: bool = False
+
+
+def _un(f):
+    return lambda a, p: f(a[0])
+
+
+def _bin(f):
+    return lambda a, p: f(a[0], a[1])
+
+
+def _iun(f):
+    return lambda lo, hi, p: f(lo[0], hi[0])
+
+
+def _ibin(f):
+    return lambda lo, hi, p: f(lo[0], hi[0], lo[1], hi[1])
+
+
+def _mp_guard(f):
+    """mpmath reference that maps a domain error or complex result to None."""
+    def ref(a, p):
+        try:
+            v = f(a, p)
+        except (ValueError, ZeroDivisionError):
+            return None
+        if v is None or isinstance(v, mpmath.mpc) or mpmath.isnan(v):
+            return None
+        return v
+    return ref
+
+
+def _mp_floor(a, p):
+    return mpmath.floor(a[0])
+
+
+def _point_powi(a, p):
+    with np.errstate(divide="ignore", over="ignore", invalid="ignore"):
+        return np.power(a[0], float(p))
+
+
+def _point_powr(a, p):
+    with np.errstate(divide="ignore", over="ignore", invalid="ignore"):
+        return np.power(np.where(a[0] < 0.0, np.nan, a[0]), p)
+
+
+def _d_powi(v, g, out, p):
+    if p == 0:
+        return g[0] * 0.0
+    with np.errstate(divide="ignore", over="ignore", invalid="ignore"):
+        return (p * np.power(v[0], float(p - 1))) * g[0]
+
+
+def _d_powr(v, g, out, p):
+    with np.errstate(divide="ignore", over="ignore", invalid="ignore"):
+        return (p * np.power(v[0], p - 1.0)) * g[0]
+
+
+def _d_div(v, g, out, p):
+    return (g[0] - out * g[1]) / v[1]
+
+
+def _d_atan2(v, g, out, p):
+    yv, xv = v
+    return (xv * g[0] - yv * g[1]) / (xv * xv + yv * yv)
+
+
+def _d_minmax(pick_first):
+    def rule(v, g, out, p):
+        return np.where(pick_first(v[0], v[1]), g[0], g[1])
+    return rule
+
+
+def _mp_powr(a, p):
+    if a[0] < 0:
+        return None
+    if a[0] == 0:
+        return mpmath.mpf(0) if p > 0 else mpmath.inf
+    return mpmath.power(a[0], mpmath.mpf(p))
+
+
+def _mp_powi(a, p):
+    if a[0] == 0 and p < 0:
+        return None
+    return a[0] ** p
+
+
+def _mp_log(a, p):
+    if a[0] < 0:
+        return None
+    return mpmath.log(a[0]) if a[0] > 0 else mpmath.ninf
+
+
+def _mp_domain(f, lo, hi):
+    return lambda a, p: f(a[0]) if lo <= a[0] <= hi else None
+
+
+def _mp_div(a, p):
+    return None if a[1] == 0 else a[0] / a[1]
+
+
+def _mp_atan2(a, p):
+    if a[0] == 0 and a[1] == 0:
+        return mpmath.mpf(0)
+    return mpmath.atan2(a[0], a[1])
+
+
+def _row(name, arity, point, interval, derivative, reference, **kw) -> Opcode:
+    return Opcode(name, arity, point, interval, derivative, _mp_guard(reference), **kw)
+
+
+_ROWS = [
+    _row("add", 2, _bin(np.add), _ibin(I.i_add),
+         lambda v, g, o, p: g[0] + g[1], lambda a, p: a[0] + a[1]),
+    _row("sub", 2, _bin(np.subtract), _ibin(I.i_sub),
+         lambda v, g, o, p: g[0] - g[1], lambda a, p: a[0] - a[1]),
+    _row("mul", 2, _bin(np.multiply), _ibin(I.i_mul),
+         lambda v, g, o, p: g[0] * v[1] + v[0] * g[1], lambda a, p: a[0] * a[1]),
+    _row("div", 2, _bin(np.divide), _ibin(I.i_div), _d_div, _mp_div),
+    _row("neg", 1, _un(np.negative), _iun(I.i_neg),
+         lambda v, g, o, p: -g[0], lambda a, p: -a[0], exact=True),
+    _row("square", 1, _un(np.square), _iun(I.i_square),
+         lambda v, g, o, p: (2.0 * v[0]) * g[0], lambda a, p: a[0] * a[0]),
+    _row("powi", 1, _point_powi, lambda lo, hi, p: I.i_powi(lo[0], hi[0], p),
+         _d_powi, _mp_powi),
+    _row("powr", 1, _point_powr, lambda lo, hi, p: I.i_powr(lo[0], hi[0], p),
+         _d_powr, _mp_powr, domain=True),
+    _row("sqrt", 1, _un(np.sqrt), _iun(I.i_sqrt),
+         lambda v, g, o, p: g[0] / (2.0 * o), _mp_domain(mpmath.sqrt, 0, mpmath.inf),
+         domain=True),
+    _row("abs", 1, _un(np.abs), _iun(I.i_abs),
+         lambda v, g, o, p: np.sign(v[0]) * g[0], lambda a, p: abs(a[0]), exact=True),
+    _row("exp", 1, _un(np.exp), _iun(I.i_exp),
+         lambda v, g, o, p: o * g[0], lambda a, p: mpmath.exp(a[0])),
+    _row("log", 1, _un(np.log), _iun(I.i_log),
+         lambda v, g, o, p: g[0] / v[0], _mp_log, domain=True),
+    _row("sin", 1, _un(np.sin), _iun(I.i_sin),
+         lambda v, g, o, p: np.cos(v[0]) * g[0], lambda a, p: mpmath.sin(a[0])),
+    _row("cos", 1, _un(np.cos), _iun(I.i_cos),
+         lambda v, g, o, p: -np.sin(v[0]) * g[0], lambda a, p: mpmath.cos(a[0])),
+    _row("tan", 1, _un(np.tan), _iun(I.i_tan),
+         lambda v, g, o, p: (1.0 + o * o) * g[0], lambda a, p: mpmath.tan(a[0])),
+    _row("atan", 1, _un(np.arctan), _iun(I.i_atan),
+         lambda v, g, o, p: g[0] / (1.0 + v[0] * v[0]), lambda a, p: mpmath.atan(a[0])),
+    _row("asin", 1, _un(np.arcsin), _iun(I.i_asin),
+         lambda v, g, o, p: g[0] / np.sqrt(1.0 - v[0] * v[0]),
+         _mp_domain(mpmath.asin, -1, 1), domain=True),
+    _row("acos", 1, _un(np.arccos), _iun(I.i_acos),
+         lambda v, g, o, p: -g[0] / np.sqrt(1.0 - v[0] * v[0]),
+         _mp_domain(mpmath.acos, -1, 1), domain=True),
+    _row("atan2", 2, _bin(np.arctan2), _ibin(I.i_atan2), _d_atan2, _mp_atan2),
+    _row("hypot", 2, _bin(np.hypot), _ibin(I.i_hypot),
+         lambda v, g, o, p: (v[0] * g[0] + v[1] * g[1]) / o,
+         lambda a, p: mpmath.sqrt(a[0] * a[0] + a[1] * a[1])),
+    _row("min", 2, _bin(np.minimum), _ibin(I.i_min),
+         _d_minmax(lambda a, b: a <= b), lambda a, p: min(a[0], a[1]), exact=True),
+    _row("max", 2, _bin(np.maximum), _ibin(I.i_max),
+         _d_minmax(lambda a, b: a >= b), lambda a, p: max(a[0], a[1]), exact=True),
+    # Tape-made forms of + - * / with an exact constant operand (the parameter):
+    # two products instead of four, no sign cases (Stolte §2's constant rule).
+    _row("addc", 1, lambda a, p: a[0] + p, lambda lo, hi, p: I.i_addc(lo[0], hi[0], p),
+         lambda v, g, o, p: g[0], lambda a, p: a[0] + p, internal=True),
+    _row("rsubc", 1, lambda a, p: p - a[0], lambda lo, hi, p: I.i_rsubc(lo[0], hi[0], p),
+         lambda v, g, o, p: -g[0], lambda a, p: p - a[0], internal=True),
+    _row("mulc", 1, lambda a, p: a[0] * p, lambda lo, hi, p: I.i_mulc(lo[0], hi[0], p),
+         lambda v, g, o, p: p * g[0], lambda a, p: a[0] * p, internal=True),
+    _row("divc", 1, lambda a, p: a[0] / p, lambda lo, hi, p: I.i_divc(lo[0], hi[0], p),
+         lambda v, g, o, p: g[0] / p, lambda a, p: a[0] / p, internal=True),
+    _row("floor", 1, _un(np.floor), _iun(I.i_floor),
+         lambda v, g, o, p: g[0] * 0.0, _mp_floor, exact=True),
+]
+
+#: name -> :class:`Opcode`, the single table of operations.
+OPCODES: dict[str, Opcode] = {row.name: row for row in _ROWS}
