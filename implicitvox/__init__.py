@@ -14,6 +14,12 @@ Examples
 """
 from .expr import Expr, constant, wrap, x, y, z
 from .function import Function, compile
+from .grid import Grid
+from .io import load
+from .octree import Octree, PointerOctree
+from .shape import AMBIGUOUS, EMPTY, FULL, Shape
+from .voxelize import voxelize
+from .voxels import Voxels
 from .functions import (abs, acos, asin, atan, atan2, clip, cos, exp, floor, hypot, log,
                         max, min, sin, sqrt, square, tan)
 
@@ -22,6 +28,8 @@ __version__ = "0.1.0"
 __all__ = [
     "Expr", "constant", "wrap", "x", "y", "z",
     "Function", "compile",
+    "voxelize", "Voxels", "Grid", "Octree", "PointerOctree", "load",
+    "Shape", "EMPTY", "FULL", "AMBIGUOUS",
     "abs", "acos", "asin", "atan", "atan2", "clip", "cos", "exp", "floor", "hypot", "log",
     "max", "min", "sin", "sqrt", "square", "tan",
 ]

@@ -1,0 +1,175 @@
+"""``Voxels``: the result of a voxelization - an octree of surface voxels on a grid.
+
+Examples
+--------
+>>> import implicitvox as iv
+>>> from implicitvox import x, y, z
+>>> vox = iv.voxelize(x**2 + y**2 + z**2 - 1, bounds=((-1.2,) * 3, (1.2,) * 3),
+...                   resolution=16, interior=True)
+>>> vox.resolution, vox.count > 0
+((16, 16, 16), True)
+>>> dense = vox.to_dense()
+>>> dense.shape, bool(dense[8, 8, 8])
+((16, 16, 16), True)
+"""
+from __future__ import annotations
+
+from typing import Any, Optional
+
+import numpy as np
+
+from .grid import Grid
+from .octree import Octree
+
+__all__ = ["Voxels", "DEFAULT_DENSE_LIMIT"]
+
+#: default memory limit of dense outputs (bytes)
+DEFAULT_DENSE_LIMIT = 4 << 30
+
+
+class Voxels:
+    """Surface voxels (and optionally interior octants and normals) of a shape.
+
+    Attributes
+    ----------
+    grid : Grid
+        Origin, voxel size and voxels per axis.
+    octree : Octree
+        The surface voxels, with payload ``"normals"`` when computed.
+    interior : dict of int to ndarray
+        FULL octants per octree level (coordinates at that level); empty
+        unless voxelized with ``interior=True``.
+    metadata : dict
+        Strings and numbers describing the run (model, timings, ...).
+    """
+
+    def __init__(self, grid: Grid, octree: Octree, interior: Optional[dict[int, np.ndarray]] = None,
+                 metadata: Optional[dict[str, Any]] = None, shape: Any = None,
+                 options: Optional[dict[str, Any]] = None):
+        self.grid = grid
+        self.octree = octree
+        self.interior = interior or {}
+        self.metadata = metadata or {}
+        self._shape = shape
+        self._options = options or {}
+
+    # -- geometry -------------------------------------------------------------------
+    @property
+    def resolution(self) -> tuple[int, int, int]:
+        """Voxels per axis."""
+        return self.grid.shape
+
+    @property
+    def voxel_size(self) -> tuple[float, float, float]:
+        return self.grid.voxel_size
+
+    @property
+    def bounds(self) -> tuple[tuple[float, ...], tuple[float, ...]]:
+        return self.grid.bounds
+
+    @property
+    def count(self) -> int:
+        """Number of surface voxels."""
+        return self.octree.count
+
+    def __len__(self) -> int:
+        return self.count
+
+    @property
+    def normals(self) -> Optional[np.ndarray]:
+        """Unit normals (n, 3) at the voxel centres in Morton order, or None."""
+        return self.octree.payload.get("normals")
+
+    def coords(self) -> np.ndarray:
+        """Surface voxel indices (n, 3), in Morton order."""
+        return self.octree.coords()
+
+    def centers(self) -> np.ndarray:
+        """Surface voxel centres (n, 3), in Morton order."""
+        return self.grid.centers(self.coords())
+
+    def contains(self, coords: np.ndarray) -> np.ndarray:
+        """Whether each voxel index (n, 3) is a surface voxel."""
+        return self.octree.contains(coords)
+
+    @property
+    def interior_count(self) -> int:
+        """Number of voxels inside FULL octants."""
+        return sum(self._expanded_count(level, c) for level, c in self.interior.items())
+
+    def _expanded_count(self, level: int, coords: np.ndarray) -> int:
+        scale = 1 << (self.grid.depth - level)
+        first = coords.astype(np.int64) * scale
+        last = np.minimum(first + scale, np.asarray(self.grid.shape))
+        return int(np.prod(last - first, axis=1).sum())
+
+    def interior_coords(self, max_memory: int = DEFAULT_DENSE_LIMIT) -> np.ndarray:
+        """Voxel indices (n, 3) inside FULL octants (expanded; memory-checked)."""
+        n = self.interior_count
+        need = n * 3 * 8
+        if need > max_memory:
+            raise MemoryError(f"interior_coords needs {need / 2**30:.2f} GiB for {n} voxels, over "
+                              f"max_memory={max_memory / 2**30:.2f} GiB; use to_dense() or "
+                              f"the per-level octants in .interior")
+        parts = []
+        for level, coords in self.interior.items():
+            scale = 1 << (self.grid.depth - level)
+            offsets = np.stack(np.meshgrid(*[np.arange(scale)] * 3, indexing="ij"), -1).reshape(-1, 3)
+            vox = (coords.astype(np.int64)[:, None, :] * scale + offsets[None]).reshape(-1, 3)
+            parts.append(vox[np.all(vox < np.asarray(self.grid.shape), axis=1)])
+        return np.concatenate(parts) if parts else np.zeros((0, 3), dtype=np.int64)
+
+    def to_dense(self, interior: bool = True, max_memory: int = DEFAULT_DENSE_LIMIT) -> np.ndarray:
+        """Boolean array of the grid's shape: surface voxels (and interior ones).
+
+        Raises
+        ------
+        MemoryError
+            If the array would need more than ``max_memory`` bytes.
+        """
+        need = int(np.prod(self.grid.shape))
+        if need > max_memory:
+            raise MemoryError(f"a dense {self.grid.shape} array needs {need / 2**30:.2f} GiB, over "
+                              f"max_memory={max_memory / 2**30:.2f} GiB")
+        dense = np.zeros(self.grid.shape, dtype=bool)
+        c = self.coords()
+        dense[c[:, 0], c[:, 1], c[:, 2]] = True
+        if interior:
+            n0, n1, n2 = self.grid.shape
+            for level, coords in self.interior.items():
+                # mark the octants on a grid of that level, then upsample and crop
+                scale = 1 << (self.grid.depth - level)
+                coarse = np.zeros([-(-n // scale) for n in self.grid.shape], dtype=bool)
+                coarse[coords[:, 0], coords[:, 1], coords[:, 2]] = True
+                fine = coarse.repeat(scale, 0).repeat(scale, 1).repeat(scale, 2)
+                dense |= fine[:n0, :n1, :n2]
+        return dense
+
+    # -- continuing -------------------------------------------------------------------
+    def refine(self, levels: int = 1, progress: Any = None) -> "Voxels":
+        """Continue the subdivision ``levels`` more levels (Stolte §1: "continued
+        from that point"): the result equals a direct voxelization at
+        ``2**levels`` times the resolution."""
+        from .voxelize import refine_voxels
+        return refine_voxels(self, levels, progress=progress)
+
+    # -- outputs ------------------------------------------------------------------------
+    def to_pyvista(self, kind: str = "points"):
+        """PyVista object: ``"points"`` (PolyData of centres, with normals) or
+        ``"cubes"`` (UnstructuredGrid of voxel cells)."""
+        from .render import to_pyvista
+        return to_pyvista(self, kind)
+
+    def render(self, path: str, **kwargs: Any) -> str:
+        """Render off screen to a PNG (see :func:`implicitvox.render.render`)."""
+        from .render import render
+        return render(self, path, **kwargs)
+
+    def save(self, path: str) -> str:
+        """Write ``.npz`` (lossless), ``.vti`` or ``.binvox`` by the file's suffix."""
+        from .io import save
+        return save(self, path)
+
+    def __repr__(self) -> str:
+        return (f"<Voxels {self.count} surface voxels, resolution {self.resolution}, "
+                f"bounds {self.bounds}>")
