@@ -1,0 +1,75 @@
+"""The implicitvox command: examples, model files, errors with locations."""
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+import implicitvox as ivx
+from implicitvox.cli import main
+
+
+def run(argv, capsys):
+    code = main(argv)
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+def test_examples_lists_stolte_models(capsys):
+    code, out, _ = run(["examples"], capsys)
+    assert code == 0 and "sinsin34" in out and "gear" in out and "torus-sweep" in out
+
+
+def test_model_file_with_progress_and_output(tmp_path, capsys):
+    model = tmp_path / "ball.py"
+    model.write_text("from implicitvox import x, y, z, sqrt\nshape = sqrt(x*x + y*y + z*z) - 1\n")
+    out_file = tmp_path / "ball.npz"
+    code, out, err = run(["voxelize", str(model), "--resolution", "24", "--bounds", "-1.2",
+                          "-1.2", "-1.2", "1.2", "1.2", "1.2", "--out", str(out_file)], capsys)
+    assert code == 0, err
+    assert "100.0%" in err and "surface voxels" in out
+    direct = ivx.voxelize(ivx.sqrt(ivx.x**2 + ivx.y**2 + ivx.z**2) - 1,
+                          ((-1.2,) * 3, (1.2,) * 3), 24)
+    assert np.array_equal(ivx.load(str(out_file)).coords(), direct.coords())
+
+
+@pytest.mark.parametrize("source, match", [
+    ("x = 1\n", "defines no `shape`"),
+    ("from implicitvox import x\n\nshape = x / undefined_name\n", r"model\.py:3: NameError"),
+    ("shape = (\n", "syntax error"),
+])
+def test_model_errors_name_the_model_line(tmp_path, capsys, source, match):
+    model = tmp_path / "model.py"
+    model.write_text(source)
+    code, _, err = run(["voxelize", str(model), "--bounds", "0", "0", "0", "1", "1", "1"], capsys)
+    assert code == 2 and "Traceback" not in err
+    import re
+    assert re.search(match, err), err
+
+
+@pytest.mark.parametrize("argv, match", [
+    (["voxelize"], "model file or --example"),
+    (["voxelize", "--example", "nope"], "unknown example"),
+    (["voxelize", "missing.py"], "no such model file"),
+    (["voxelize", "--example", "sphere", "--resolution", "0"], "between 1 and"),
+    (["voxelize", "--example", "sphere", "--out", "/no/such/dir/v.npz"], "cannot write --out"),
+    (["voxelize", "--example", "sphere", "--bounds", "0", "0", "0", "0", "1", "1"], "extent"),
+    (["voxelize", "--example", "sinsin918", "--resolution", "8192", "--max-memory", "0.1"],
+     "over the budget"),
+])
+def test_bad_input_is_refused_clearly(argv, match, capsys):
+    code, _, err = run(argv, capsys)
+    assert code == 2 and match in err and "Traceback" not in err
+
+
+def test_console_entry_point_renders_an_example(tmp_path):
+    png = tmp_path / "gear.png"
+    env = dict(os.environ, VTK_DEFAULT_OPENGL_WINDOW="vtkEGLRenderWindow")
+    proc = subprocess.run([sys.executable, "-m", "implicitvox.cli", "voxelize", "--example", "gear",
+                           "--resolution", "64", "--render", str(png)],
+                          capture_output=True, text=True, env=env, timeout=300)
+    assert proc.returncode == 0, proc.stderr
+    assert png.stat().st_size > 10_000

@@ -1,0 +1,105 @@
+"""voxelize: refine, interior, normals, progress, memory limits and bad input."""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+import implicitvox as ivx
+from implicitvox import sqrt, x, y, z
+from implicitvox.examples import gear, sinsin
+
+BALL = sqrt(x * x + y * y + z * z) - 0.7
+CUBE = ((-1.0,) * 3, (1.0,) * 3)
+
+
+@pytest.mark.parametrize("shape, res", [(sinsin(3, 4), 16), (gear(), 24), (BALL, (10, 7, 12))])
+def test_refine_equals_direct_voxelization(shape, res):
+    coarse = ivx.voxelize(shape, CUBE if shape is BALL else None, res, interior=True)
+    refined = coarse.refine(2)
+    fine_res = tuple(4 * n for n in coarse.resolution)
+    direct = ivx.voxelize(shape, CUBE if shape is BALL else None, fine_res, interior=True)
+    assert refined.grid == direct.grid
+    np.testing.assert_array_equal(refined.coords(), direct.coords())
+    np.testing.assert_array_equal(refined.to_dense(), direct.to_dense())
+
+
+def test_interior_and_surface_bracket_the_volume():
+    vox = ivx.voxelize(BALL, CUBE, 64, interior=True)
+    voxel_volume = np.prod(vox.voxel_size)
+    true = 4 / 3 * math.pi * 0.7 ** 3
+    assert vox.interior_count * voxel_volume <= true <= (vox.interior_count + vox.count) * voxel_volume
+    inner = vox.interior_coords()
+    assert len(inner) == vox.interior_count
+    assert not vox.contains(inner).any()  # interior and surface are disjoint
+
+
+def test_normals_are_unit_gradients():
+    vox = ivx.voxelize(BALL, CUBE, 32, normals=True)
+    radial = vox.centers() / np.linalg.norm(vox.centers(), axis=1, keepdims=True)
+    np.testing.assert_allclose(vox.normals, radial, atol=1e-6)
+
+
+def test_progress_reports_rising_shares_to_one():
+    seen = []
+    ivx.voxelize(sinsin(3, 4), resolution=64, progress=seen.append)
+    assert seen and seen[-1] == 1.0 and all(b >= a for a, b in zip(seen, seen[1:]))
+
+
+def test_resolution_sets_near_cubic_voxels_and_exact_bounds():
+    vox = ivx.voxelize(BALL, ((-1, -1, -0.5), (1, 1, 0.5)), 40)
+    assert vox.resolution == (40, 40, 20)
+    assert vox.bounds == ((-1.0, -1.0, -0.5), (1.0, 1.0, 0.5))
+
+
+def test_undefined_regions_are_empty():
+    vox = ivx.voxelize(sqrt(x) - 0.5, CUBE, 16)  # undefined for x < 0
+    assert vox.count > 0 and vox.coords()[:, 0].min() >= 8
+
+
+@pytest.mark.parametrize("bounds, match", [
+    (((0, 0, float("nan")), (1, 1, 1)), "finite"),
+    (((0, 0, 0), (1, 0, 1)), "zero or negative extent on axis y"),
+    (((0, 0, 0),), "shape"),
+    ("abc", "bounds must be"),
+])
+def test_bad_bounds(bounds, match):
+    with pytest.raises(ValueError, match=match):
+        ivx.voxelize(BALL, bounds, 8)
+
+
+@pytest.mark.parametrize("res, match", [
+    (0, "between 1 and"), (10**9, "between 1 and"), (2.5, "positive int"), (True, "positive int"),
+    ((4, 4), "3 ints"),
+])
+def test_bad_resolution(res, match):
+    with pytest.raises(ValueError, match=match):
+        ivx.voxelize(BALL, CUBE, res)
+
+
+def test_missing_bounds_and_bad_shape():
+    with pytest.raises(ValueError, match="bounds is required"):
+        ivx.voxelize(BALL)
+    with pytest.raises(TypeError, match="got str"):
+        ivx.voxelize("x*x", CUBE, 8)
+
+
+def test_memory_budget_refuses_before_starting():
+    with pytest.raises(MemoryError, match="over the budget"):
+        ivx.voxelize(sinsin(9, 18), resolution=4096, max_memory=100 << 20)
+    with pytest.raises(ValueError, match="max_memory"):
+        ivx.voxelize(BALL, CUBE, 8, max_memory=-5)
+
+
+def test_dense_outputs_check_memory():
+    vox = ivx.voxelize(BALL, CUBE, 32)
+    with pytest.raises(MemoryError, match="max_memory"):
+        vox.to_dense(max_memory=1000)
+
+
+def test_refine_of_loaded_voxels_needs_the_shape(tmp_path):
+    vox = ivx.voxelize(BALL, CUBE, 8)
+    back = ivx.load(vox.save(str(tmp_path / "b.npz")))
+    with pytest.raises(ValueError, match="needs the shape"):
+        back.refine()
