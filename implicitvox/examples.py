@@ -7,7 +7,7 @@ Examples
 --------
 >>> from implicitvox.examples import EXAMPLES, example
 >>> sorted(EXAMPLES)[:3]
-['blobby', 'gear', 'sinsin34']
+['blobby', 'gear', 'lobed-plate']
 >>> example("gear").bounds
 ((-1.0, -0.3, -1.0), (1.0, 0.3, 1.0))
 """
