@@ -91,6 +91,12 @@ class Grid:
         hi = tuple(self.edge(a, self.shape[a]) for a in range(3))
         return self.origin, hi
 
+    def finer(self, levels: int) -> "Grid":
+        """The grid with each voxel split ``2**levels`` times per axis (same edges)."""
+        f = 1 << levels
+        return Grid(self.origin, tuple(h / f for h in self.voxel_size),
+                    tuple(n * f for n in self.shape))
+
     def edge(self, axis: int, m: Any) -> Any:
         """World coordinate of voxel boundary ``m`` along ``axis`` (the one formula)."""
         return self.origin[axis] + np.asarray(m, dtype=np.float64) * self.voxel_size[axis]

@@ -31,6 +31,7 @@ import mpmath
 import numpy as np
 
 from . import interval as I
+from .interval_derivatives import RULES as _INTERVAL_DERIVATIVES
 
 __all__ = ["Opcode", "OPCODES"]
 
@@ -50,6 +51,8 @@ class Opcode:
     exact: bool = False
     #: made by the tape (an operation with an exact constant operand), not the DSL
     internal: bool = False
+    #: interval chain rule (:mod:`implicitvox.interval_derivatives`), for the mean value form
+    interval_derivative: Callable[..., Any] | None = None
 
 
 def _un(f):
@@ -157,7 +160,8 @@ def _mp_atan2(a, p):
 
 
 def _row(name, arity, point, interval, derivative, reference, **kw) -> Opcode:
-    return Opcode(name, arity, point, interval, derivative, _mp_guard(reference), **kw)
+    return Opcode(name, arity, point, interval, derivative, _mp_guard(reference),
+                  interval_derivative=_INTERVAL_DERIVATIVES[name], **kw)
 
 
 _ROWS = [

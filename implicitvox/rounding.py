@@ -59,7 +59,7 @@ _MAX = float(np.finfo(np.float64).max)
 
 def down(a: np.ndarray, ulps: int = 1) -> np.ndarray:
     """A value at least ``ulps`` floats below ``a`` (``+inf`` -> largest float)."""
-    step = np.abs(a)
+    step = np.asanyarray(np.abs(a))  # 0-d for scalars, so the in-place steps work
     step *= ulps * _EPS
     step += _TINY
     with np.errstate(invalid="ignore"):
@@ -69,7 +69,7 @@ def down(a: np.ndarray, ulps: int = 1) -> np.ndarray:
 
 def up(a: np.ndarray, ulps: int = 1) -> np.ndarray:
     """A value at least ``ulps`` floats above ``a`` (``-inf`` -> most negative float)."""
-    step = np.abs(a)
+    step = np.asanyarray(np.abs(a))
     step *= ulps * _EPS
     step += _TINY
     with np.errstate(invalid="ignore"):
@@ -79,7 +79,7 @@ def up(a: np.ndarray, ulps: int = 1) -> np.ndarray:
 
 def down_nonneg(a: np.ndarray, ulps: int = 1) -> np.ndarray:
     """:func:`down` for ``a >= 0``, clamped at 0 (the result is known non-negative)."""
-    out = np.multiply(a, 1.0 - ulps * _EPS)
+    out = np.asanyarray(np.multiply(a, 1.0 - ulps * _EPS))
     out -= _TINY
     return np.clip(out, 0.0, _MAX, out=out)
 

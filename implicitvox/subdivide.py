@@ -27,6 +27,7 @@ import numpy as np
 
 from .function import Function
 from .grid import Grid
+from .mean_value import mean_value_enclosure
 from .shape import AMBIGUOUS, EMPTY, FULL
 
 __all__ = ["subdivide", "Subdivision", "classify", "CHUNK"]
@@ -48,15 +49,33 @@ class Subdivision:
     evaluated: int = 0
 
 
-def classify(func: Function, grid: Grid, level: int, coords: np.ndarray,
-             exact: Optional[Callable[[np.ndarray, np.ndarray], np.ndarray]] = None
-             ) -> np.ndarray:
-    """States (int8) of octants ``coords`` at ``level``: EMPTY, FULL or AMBIGUOUS."""
-    lo, hi = grid.octant_boxes(level, coords)
-    flo, fhi = func.interval_columns(lo, hi)
-    state = np.full(coords.shape[0], AMBIGUOUS, dtype=np.int8)
+def _states(flo: np.ndarray, fhi: np.ndarray) -> np.ndarray:
+    state = np.full(flo.shape[0], AMBIGUOUS, dtype=np.int8)
     state[fhi < 0.0] = FULL
     state[flo > 0.0] = EMPTY  # also the empty interval (inf, -inf): undefined
+    return state
+
+
+def classify(func: Function, grid: Grid, level: int, coords: np.ndarray,
+             exact: Optional[Callable[[np.ndarray, np.ndarray], np.ndarray]] = None,
+             mean_value: bool = True) -> np.ndarray:
+    """States (int8) of octants ``coords`` at ``level``: EMPTY, FULL or AMBIGUOUS.
+
+    The natural interval extension decides first; octants it leaves
+    AMBIGUOUS get the mean value form (:mod:`implicitvox.mean_value`) when
+    ``mean_value``, then the shape's exact test. A box's state depends on the
+    box alone, not on the level or the run, so ``Voxels.refine`` matches a
+    direct voxelization.
+    """
+    lo, hi = grid.octant_boxes(level, coords)
+    flo, fhi = func.interval_columns(lo, hi)
+    state = _states(flo, fhi)
+    if mean_value:
+        amb = np.flatnonzero(state == AMBIGUOUS)
+        if amb.size:
+            sub_lo, sub_hi = tuple(c[amb] for c in lo), tuple(c[amb] for c in hi)
+            mlo, mhi = mean_value_enclosure(func.tape, sub_lo, sub_hi, (flo[amb], fhi[amb]))
+            state[amb] = _states(mlo, mhi)
     if exact is not None:
         amb = np.flatnonzero(state == AMBIGUOUS)
         if amb.size:
@@ -98,8 +117,8 @@ class _Progress:
 
 
 def subdivide(func: Function, grid: Grid, *, start: Optional[tuple[int, np.ndarray]] = None,
-              interior: bool = False, exact=None, progress=None, chunk: int = CHUNK
-              ) -> Subdivision:
+              interior: bool = False, exact=None, progress=None, chunk: int = CHUNK,
+              mean_value: bool = True) -> Subdivision:
     """Classify octants from the root (or from ``start``) down to the voxels.
 
     Parameters
@@ -119,6 +138,8 @@ def subdivide(func: Function, grid: Grid, *, start: Optional[tuple[int, np.ndarr
         Called with the estimated share of work done, in [0, 1].
     chunk : int
         Octants per interval evaluation.
+    mean_value : bool, default: True
+        Tighten AMBIGUOUS octants with the mean value form.
     """
     depth = grid.depth
     level0, coords0 = start if start is not None else (0, np.zeros((1, 3), dtype=np.int32))
@@ -132,7 +153,7 @@ def subdivide(func: Function, grid: Grid, *, start: Optional[tuple[int, np.ndarr
         level, octants = stack.pop()
         if len(octants) == 0:
             continue
-        state = classify(func, grid, level, octants, exact)
+        state = classify(func, grid, level, octants, exact, mean_value)
         evaluated += len(octants)
         meter.done += len(octants)
         if interior:

@@ -17,6 +17,7 @@ from typing import Any, Callable, Optional, Union
 
 import numpy as np
 
+from . import morton
 from .function import Function
 from .grid import Grid
 from .octree import Octree
@@ -81,7 +82,8 @@ def _compute_normals(func: Function, grid: Grid, coords: np.ndarray,
 def voxelize(shape: Any, bounds: Any = None, resolution: Union[int, tuple[int, int, int]] = 256,
              *, interior: bool = False, normals: bool = False,
              progress: Optional[Callable[[float], Any]] = None,
-             max_memory: Optional[int] = None) -> Voxels:
+             max_memory: Optional[int] = None, mean_value: bool = True,
+             subvoxel: int = 0) -> Voxels:
     """Voxelize a shape: every voxel whose closed box the surface meets is output.
 
     Interval arithmetic rejects octants the surface cannot meet and
@@ -105,6 +107,14 @@ def voxelize(shape: Any, bounds: Any = None, resolution: Union[int, tuple[int, i
     max_memory : int, optional
         Refuse (``MemoryError``) before starting when the estimated peak
         exceeds this many bytes; default half the available memory.
+    mean_value : bool, default: True
+        Tighten octants the natural interval extension leaves AMBIGUOUS with
+        the mean value form (:mod:`implicitvox.mean_value`); about 3x the
+        time, 10-15% fewer false voxels on curved surfaces.
+    subvoxel : int, default: 0
+        Sub-voxel refinement: keep a voxel only if one of its ``8**subvoxel``
+        sub-voxels stays AMBIGUOUS. Tighter (never a miss), about
+        ``4**subvoxel`` times the work.
 
     Returns
     -------
@@ -126,7 +136,13 @@ def voxelize(shape: Any, bounds: Any = None, resolution: Union[int, tuple[int, i
     if max_memory is not None and (isinstance(max_memory, bool) or not
                                    isinstance(max_memory, (int, np.integer)) or max_memory <= 0):
         raise ValueError(f"max_memory must be a positive number of bytes, got {max_memory!r}")
+    if isinstance(subvoxel, bool) or not isinstance(subvoxel, (int, np.integer)) \
+            or not 0 <= subvoxel <= 4:
+        raise ValueError(f"subvoxel must be an int from 0 to 4, got {subvoxel!r}")
     grid = Grid.from_bounds(bounds, resolution)
+    if grid.depth + subvoxel > 21:
+        raise ValueError(f"resolution {grid.shape} with subvoxel={subvoxel} exceeds the octree's "
+                         "21 levels")
     func = Function(shape.expr)
     budget = _default_budget() if max_memory is None else int(max_memory)
     estimated_voxels, estimated_bytes = estimate_memory(func, grid, normals)
@@ -135,15 +151,15 @@ def voxelize(shape: Any, bounds: Any = None, resolution: Union[int, tuple[int, i
             f"voxelizing at {grid.shape} needs an estimated {estimated_bytes / 2**30:.2f} GiB "
             f"(~{estimated_voxels:,} surface voxels), over the budget of {budget / 2**30:.2f} GiB; "
             "lower the resolution or raise max_memory")
-    options = {"interior": interior, "normals": normals}
+    options = {"interior": interior, "normals": normals, "mean_value": bool(mean_value),
+               "subvoxel": int(subvoxel)}
     return _run(shape, func, grid, options, progress, start=None, interior_before=None,
                 estimated_voxels=estimated_voxels)
 
 
 def _run(shape, func, grid, options, progress, start, interior_before, estimated_voxels=None):
     t0 = time.perf_counter()
-    result = subdivide(func, grid, start=start, interior=options["interior"],
-                       exact=exact_classifier(shape), progress=progress)
+    result = _subdivide(func, grid, options, exact_classifier(shape), progress, start)
     t1 = time.perf_counter()
     payload = {}
     if options["normals"]:
@@ -163,6 +179,39 @@ def _run(shape, func, grid, options, progress, start, interior_before, estimated
     return Voxels(grid, tree, interior, metadata, shape=shape, options=options)
 
 
+def _subdivide(func, grid, options, exact, progress, start):
+    """Subdivide on the grid, or on a finer one mapped back (``subvoxel``)."""
+    s = options["subvoxel"]
+    result = subdivide(func, grid.finer(s) if s else grid, start=start,
+                       interior=options["interior"], exact=exact, progress=progress,
+                       mean_value=options["mean_value"])
+    if not s:
+        return result
+    result.surface = np.unique(result.surface >> s, axis=0).astype(np.int32)
+    result.interior = _interior_from_subvoxels(result.interior, grid, s, result.surface)
+    return result
+
+
+def _interior_from_subvoxels(interior, grid, s, surface):
+    """FULL octants above the voxel level stay; below it, a voxel is interior
+    when FULL sub-octants cover all of it."""
+    depth = grid.depth
+    kept = {lvl: c for lvl, c in interior.items() if lvl <= depth}
+    voxels, weights = [], []
+    for lvl, c in interior.items():
+        if lvl > depth:
+            voxels.append(c >> (lvl - depth))
+            weights.append(np.full(len(c), 8 ** (depth + s - lvl), dtype=np.int64))
+    if voxels:
+        codes = morton.encode(np.concatenate(voxels))
+        uniq, inverse = np.unique(codes, return_inverse=True)
+        covered = np.bincount(inverse, weights=np.concatenate(weights))
+        whole = morton.decode(uniq[covered == 8 ** s]).astype(np.int32)
+        if len(whole):
+            kept[depth] = np.concatenate([kept[depth], whole]) if depth in kept else whole
+    return kept
+
+
 def _version() -> str:
     from . import __version__
     return __version__
@@ -175,11 +224,7 @@ def refine_voxels(vox: Voxels, levels: int, progress=None) -> Voxels:
     if vox._shape is None:
         raise ValueError("refine needs the shape: these voxels were loaded from a file; "
                          "voxelize the shape again at the finer resolution")
-    factor = 1 << levels
-    grid = Grid(vox.grid.origin, tuple(h / factor for h in vox.grid.voxel_size),
-                tuple(n * factor for n in vox.grid.shape))
-    if grid.depth != vox.grid.depth + levels:  # cannot happen: shape scales by 2**levels
-        raise AssertionError("grid depth mismatch")
+    grid = vox.grid.finer(levels)
     coords = vox.coords().astype(np.int32)
     # The stored surface voxels are the AMBIGUOUS octants at the old depth: go on from there.
     from .subdivide import _children

@@ -8,6 +8,10 @@ from implicitvox.expr import Expr
 from implicitvox.opcodes import OPCODES
 
 DPS = 60
+#: periodic functions of larger arguments are not checked pointwise (mpmath would
+#: need pi to thousands of digits); the per-opcode tests cover them up to 1e15.
+PERIODIC_LIMIT = mpmath.mpf(10) ** 15
+_PERIODIC = {"sin", "cos", "tan"}
 
 
 def mp_value(expr: Expr, point, dps: int = DPS):
@@ -23,6 +27,8 @@ def mp_value(expr: Expr, point, dps: int = DPS):
             else:
                 args = [vals[id(a)] for a in node.args]
                 if any(a is None for a in args):
+                    v = None
+                elif node.op in _PERIODIC and abs(args[0]) > PERIODIC_LIMIT:
                     v = None
                 else:
                     v = OPCODES[node.op].reference(args, node.param)
@@ -66,6 +72,8 @@ def iv_interval(expr: Expr, lo, hi, dps: int = 40):
             v = box[node.param]
         elif node.op == "const":
             v = iv.mpf(node.param)
+        elif node.op == "mul" and node.args[0].equals(node.args[1]):
+            v = vals[id(node.args[0])] ** 2  # the tape rewrites a * a as square(a)
         else:
             v = IV_OPS[node.op]([vals[id(a)] for a in node.args], node.param)
         vals[id(node)] = v

@@ -72,9 +72,9 @@ MODELS = {
 }
 
 
-def _run(name):
+def _run(name, **options):
     expr, bounds, inside = MODELS[name]()
-    vox = ivx.voxelize(expr, bounds, RES)
+    vox = ivx.voxelize(expr, bounds, RES, **options)
     func = ivx.compile(expr)
     step = float(np.max(vox.voxel_size))
     a, b = surface_brackets(func, bounds, step, N_POINTS, np.random.default_rng(11), inside)
@@ -89,6 +89,13 @@ def test_every_surface_point_lies_in_an_output_voxel(name):
     assert np.all(np.abs(a - b) <= 4 * np.spacing(np.abs(a) + 1e-300) + 1e-300)  # bisected
     hit = found(vox.contains, vox.grid, a, b)
     assert hit.all(), f"{name}: {np.count_nonzero(~hit)} of {len(a)} surface points missed"
+
+
+@pytest.mark.parametrize("name", ["sinsin34", "thin-sheet", "tiny-sphere", "gear"])
+@pytest.mark.parametrize("options", [{"subvoxel": 2}, {"mean_value": False}])
+def test_options_never_miss_either(name, options):
+    vox, func, a, b = _run(name, **options)
+    assert found(vox.contains, vox.grid, a, b).all()
 
 
 @pytest.mark.parametrize("name", ["thin-sheet", "tiny-sphere"])

@@ -14,15 +14,33 @@ BALL = sqrt(x * x + y * y + z * z) - 0.7
 CUBE = ((-1.0,) * 3, (1.0,) * 3)
 
 
-@pytest.mark.parametrize("shape, res", [(sinsin(3, 4), 16), (gear(), 24), (BALL, (10, 7, 12))])
-def test_refine_equals_direct_voxelization(shape, res):
-    coarse = ivx.voxelize(shape, CUBE if shape is BALL else None, res, interior=True)
+@pytest.mark.parametrize("shape, res, options", [
+    (sinsin(3, 4), 16, {}), (gear(), 24, {}), (BALL, (10, 7, 12), {}),
+    (sinsin(3, 4), 16, {"subvoxel": 1}), (gear(), 16, {"mean_value": False}),
+])
+def test_refine_equals_direct_voxelization(shape, res, options):
+    bounds = CUBE if shape is BALL else None
+    coarse = ivx.voxelize(shape, bounds, res, interior=True, **options)
     refined = coarse.refine(2)
     fine_res = tuple(4 * n for n in coarse.resolution)
-    direct = ivx.voxelize(shape, CUBE if shape is BALL else None, fine_res, interior=True)
+    direct = ivx.voxelize(shape, bounds, fine_res, interior=True, **options)
     assert refined.grid == direct.grid
     np.testing.assert_array_equal(refined.coords(), direct.coords())
     np.testing.assert_array_equal(refined.to_dense(), direct.to_dense())
+
+
+@pytest.mark.parametrize("subvoxel", [1, 2])
+def test_subvoxel_refinement_is_a_subset_and_keeps_the_interior(subvoxel):
+    base = ivx.voxelize(sinsin(3, 4), resolution=32, interior=True)
+    tight = ivx.voxelize(sinsin(3, 4), resolution=32, interior=True, subvoxel=subvoxel)
+    assert tight.count < base.count and base.contains(tight.coords()).all()
+    # dropped surface voxels are outside or wholly inside: solid = surface + interior grows
+    # only by voxels that were surface before
+    assert np.all(tight.to_dense() <= base.to_dense())
+    ball = ivx.voxelize(BALL, CUBE, 32, interior=True, subvoxel=subvoxel)
+    true = 4 / 3 * math.pi * 0.7 ** 3
+    v = np.prod(ball.voxel_size)
+    assert ball.interior_count * v <= true <= (ball.interior_count + ball.count) * v
 
 
 def test_interior_and_surface_bracket_the_volume():
@@ -67,6 +85,11 @@ def test_undefined_regions_are_empty():
 def test_bad_bounds(bounds, match):
     with pytest.raises(ValueError, match=match):
         ivx.voxelize(BALL, bounds, 8)
+
+
+def test_bad_subvoxel():
+    with pytest.raises(ValueError, match="subvoxel"):
+        ivx.voxelize(BALL, CUBE, 8, subvoxel=9)
 
 
 @pytest.mark.parametrize("res, match", [
