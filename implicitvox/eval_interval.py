@@ -23,23 +23,38 @@ def evaluate_intervals(tape: Tape, lo: tuple[np.ndarray, np.ndarray, np.ndarray]
 
     Parameters
     ----------
-    lo, hi : tuple of three 1-D arrays
+    lo, hi : tuple of three arrays
         The box corners by axis: box ``i`` is
         ``[lo[0][i], hi[0][i]] x [lo[1][i], hi[1][i]] x [lo[2][i], hi[2][i]]``.
-        No NaN, ``lo <= hi`` (the caller checks).
+        No NaN, ``lo <= hi`` (the caller checks). The arrays may have any
+        shapes that broadcast together with a common last axis: the
+        subdivision passes the children of ``m`` octants as ``x`` bounds of
+        shape ``(1, 1, 2, m)``, ``y`` of ``(1, 2, 1, m)`` and ``z`` of
+        ``(2, 1, 1, m)``, so a subexpression of ``x`` alone is computed on 2
+        boxes per octant instead of 8 (broadcasting does the rest; the long
+        axis is innermost, where numpy's loops are fast).
+
+    Returns
+    -------
+    flo, fhi : ndarray
+        Of the broadcast shape.
     """
-    n = lo[0].shape[0]
-    if n > CHUNK:
-        parts = [_evaluate(tape, tuple(c[s:s + CHUNK] for c in lo),
-                           tuple(c[s:s + CHUNK] for c in hi)) for s in range(0, n, CHUNK)]
-        return np.concatenate([p[0] for p in parts]), np.concatenate([p[1] for p in parts])
+    shape = np.broadcast_shapes(*(a.shape for a in lo), *(a.shape for a in hi))
+    columns = shape[-1] if shape else 1
+    per_column = max(1, int(np.prod(shape[:-1], dtype=np.int64))) if shape else 1
+    step = max(1, CHUNK // per_column)
+    if columns > step:
+        parts = [_evaluate(tape, tuple(c[..., s:s + step] for c in lo),
+                           tuple(c[..., s:s + step] for c in hi)) for s in range(0, columns, step)]
+        return (np.concatenate([p[0] for p in parts], axis=-1),
+                np.concatenate([p[1] for p in parts], axis=-1))
     return _evaluate(tape, lo, hi)
 
 
 def _evaluate(tape, lo, hi):
-    n = lo[0].shape[0]
+    shape = np.broadcast_shapes(*(a.shape for a in lo), *(a.shape for a in hi))
     if tape.undefined:
-        return np.full(n, np.inf), np.full(n, -np.inf)
+        return np.full(shape, np.inf), np.full(shape, -np.inf)
     rlo: list = [None] * tape.n_registers
     rhi: list = [None] * tape.n_registers
     for axis, name in enumerate("xyz"):
@@ -57,10 +72,10 @@ def _evaluate(tape, lo, hi):
                 result, lane_empty = result[:2], result[2]
                 empty = lane_empty if empty is None else (empty | lane_empty)
             rlo[ins.out], rhi[ins.out] = result
-    flo = np.array(np.broadcast_to(rlo[tape.output], (n,)), dtype=np.float64)
-    fhi = np.array(np.broadcast_to(rhi[tape.output], (n,)), dtype=np.float64)
+    flo = np.array(np.broadcast_to(rlo[tape.output], shape), dtype=np.float64)
+    fhi = np.array(np.broadcast_to(rhi[tape.output], shape), dtype=np.float64)
     if empty is not None:
-        empty = np.broadcast_to(empty, (n,))
+        empty = np.broadcast_to(empty, shape)
         flo[empty] = np.inf
         fhi[empty] = -np.inf
     return flo, fhi

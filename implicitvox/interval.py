@@ -216,31 +216,37 @@ def i_log(alo, ahi):
 
 
 # -- trigonometry -------------------------------------------------------------------
-def _holds_phase(alo, ahi, period: float, phase: float):
-    """Does ``[alo, ahi]`` hold a point ``t`` with ``t / period - phase`` an integer?
+def _holds_phase(u_lo, u_hi, slack, phase: float):
+    """Does ``[u_lo, u_hi]`` (in periods) hold a point ``u`` with ``u - phase`` an integer?
 
-    Conservative: the slack covers the rounding of the division, so a point
-    just outside may count as inside (a wider, still valid interval), never
-    the reverse. Intervals of width >= one period always hold one; beyond
-    about 1e13 periods from 0 every interval is said to hold one.
+    Conservative: ``slack`` covers the rounding of the conversion to periods,
+    so a point just outside may count as inside (a wider, still valid
+    interval), never the reverse. Beyond about 1e12 periods from 0 the slack
+    exceeds one period and every interval holds every phase.
     """
-    u_lo = alo / period - phase
-    u_hi = ahi / period - phase
-    slack_lo = 1e-12 * (1.0 + np.abs(u_lo))
-    slack_hi = 1e-12 * (1.0 + np.abs(u_hi))
+    return np.floor(u_hi - phase + slack) >= np.ceil(u_lo - phase - slack)
+
+
+def _in_periods(alo, ahi, period: float):
+    u_lo = alo * (1.0 / period)
+    u_hi = ahi * (1.0 / period)
+    slack = 1e-12 * (1.0 + np.maximum(np.abs(u_lo), np.abs(u_hi)))
     with np.errstate(invalid="ignore"):
-        held = np.floor(u_hi + slack_hi) >= np.ceil(u_lo - slack_lo)
-    return held | ~np.isfinite(u_lo) | ~np.isfinite(u_hi)
+        slack = np.where(np.isfinite(slack), slack, np.inf)  # an infinite end holds all
+    return u_lo, u_hi, slack
 
 
 def _periodic(alo, ahi, f, max_phase: float, min_phase: float):
     with np.errstate(invalid="ignore"):
         fa, fb = f(alo), f(ahi)
+        u_lo, u_hi, slack = _in_periods(alo, ahi, _TWO_PI)
+        has_max = _holds_phase(u_lo, u_hi, slack, max_phase)
+        has_min = _holds_phase(u_lo, u_hi, slack, min_phase)
     lo = R.down(np.fmin(fa, fb), T)
     hi = R.up(np.fmax(fa, fb), T)
-    hi = np.where(_holds_phase(alo, ahi, _TWO_PI, max_phase), 1.0, np.minimum(hi, 1.0))
-    lo = np.where(_holds_phase(alo, ahi, _TWO_PI, min_phase), -1.0, np.maximum(lo, -1.0))
-    # sin(inf) is NaN: an infinite endpoint already made both phases "held".
+    hi = np.where(has_max, 1.0, np.minimum(hi, 1.0))
+    lo = np.where(has_min, -1.0, np.maximum(lo, -1.0))
+    # sin(inf) is NaN: an infinite endpoint made the slack infinite, so both are held.
     return lo, hi
 
 
@@ -253,7 +259,8 @@ def i_cos(alo, ahi):
 
 
 def i_tan(alo, ahi):
-    pole = _holds_phase(alo, ahi, np.pi, 0.5)
+    with np.errstate(invalid="ignore"):
+        pole = _holds_phase(*_in_periods(alo, ahi, np.pi), 0.5)
     with np.errstate(invalid="ignore"):
         lo = R.down(np.tan(alo), T)
         hi = R.up(np.tan(ahi), T)
@@ -284,15 +291,24 @@ def i_atan2(ylo, yhi, xlo, xhi):
     """``atan2(y, x)`` over the box ``[xlo, xhi] x [ylo, yhi]``.
 
     Off the origin and the negative x axis the angle is continuous and its
-    extremes over a box are at corners (its level sets are rays from the
-    origin). A box meeting the negative x axis (where numpy's atan2 jumps
-    from pi to -pi, including y = +-0) or holding the origin gets
-    ``[-pi, pi]``.
+    extremes over a box are at the two corners seen at the box's silhouette
+    from the origin (its level sets are rays); which corners, follows from
+    the quadrant (Stolte §4.1.2, the cases of Fig. 3): above the x axis the
+    smallest angle is at ``x = xhi``, below at ``x = xlo``, and so on. A box
+    meeting the negative x axis (where numpy's atan2 jumps from pi to -pi,
+    including y = +-0) or holding the origin gets ``[-pi, pi]``.
     """
-    lo, hi = _hull4(np.arctan2(ylo, xlo), np.arctan2(ylo, xhi),
-                    np.arctan2(yhi, xlo), np.arctan2(yhi, xhi))
-    lo = np.maximum(R.down(lo, T), -PI_UP)
-    hi = np.minimum(R.up(hi, T), PI_UP)
+    upper = ylo > 0.0
+    lower = yhi < 0.0
+    # the corner of least angle, and of greatest angle
+    min_x = np.where(upper, xhi, xlo)
+    min_y = np.where(upper, np.where(xhi <= 0.0, yhi, ylo),
+                     np.where(lower, np.where(xlo >= 0.0, ylo, yhi), ylo))
+    max_x = np.where(upper | ~lower, xlo, xhi)
+    max_y = np.where(upper, np.where(xlo >= 0.0, yhi, ylo),
+                     np.where(lower, np.where(xhi <= 0.0, ylo, yhi), yhi))
+    lo = np.maximum(R.down(np.arctan2(min_y, min_x), T), -PI_UP)
+    hi = np.minimum(R.up(np.arctan2(max_y, max_x), T), PI_UP)
     full = (xlo <= 0.0) & (ylo <= 0.0) & (yhi >= 0.0)
     return np.where(full, -PI_UP, lo), np.where(full, PI_UP, hi)
 

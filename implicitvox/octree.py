@@ -34,6 +34,7 @@ Examples
 """
 from __future__ import annotations
 
+import sys
 from typing import Any, Iterator, Optional
 
 import numpy as np
@@ -46,6 +47,14 @@ _POPCOUNT = np.array([bin(v).count("1") for v in range(256)], dtype=np.uint8)
 _BELOW = np.array([[bin(v & ((1 << c) - 1)).count("1") for c in range(8)] for v in range(256)],
                   dtype=np.uint8)  # set bits of mask v below slot c
 _U = np.uint64
+_SLOT_BIT = np.array([1 << c for c in range(8)], dtype=np.uint8)
+
+
+def _low_byte(codes: np.ndarray) -> np.ndarray:
+    """The lowest byte of each uint64 code, as a view where the layout allows."""
+    if sys.byteorder == "little" and codes.flags.c_contiguous:
+        return codes.view(np.uint8)[::8]
+    return (codes & _U(255)).astype(np.uint8)
 
 
 class Octree:
@@ -83,13 +92,24 @@ class Octree:
         if len(coords) and (coords.min() < 0 or coords.max() >= (1 << depth)):
             raise ValueError(f"coords must lie in [0, {1 << depth}) for depth {depth}")
         codes = morton.encode(coords)
-        order = np.argsort(codes, kind="stable")
-        codes = codes[order]
-        keep = np.ones(len(codes), dtype=bool)
-        keep[1:] = codes[1:] != codes[:-1]
-        codes = codes[keep]
-        payload = {k: np.asarray(v)[order][keep] for k, v in (payload or {}).items()}
-        return cls._from_sorted_codes(codes, depth, payload)
+        order = None
+        if payload:
+            order = np.argsort(codes, kind="stable")
+            codes = codes[order]
+        else:
+            codes.sort()                       # in place: no second 8-byte-per-voxel array
+        repeated = codes[1:] == codes[:-1]
+        keep = None
+        if repeated.any():
+            keep = np.ones(len(codes), dtype=bool)
+            keep[1:] = ~repeated
+            codes = codes[keep]
+        del repeated
+        out_payload = {}
+        for k, v in (payload or {}).items():
+            v = np.asarray(v)[order]
+            out_payload[k] = v if keep is None else v[keep]
+        return cls._from_sorted_codes(codes, depth, out_payload)
 
     @classmethod
     def _from_sorted_codes(cls, codes: np.ndarray, depth: int,
@@ -101,11 +121,13 @@ class Octree:
         first: list[np.ndarray] = [None] * (depth - 1)  # type: ignore[list-item]
         level_codes = codes
         for level in range(depth - 1, -1, -1):
+            bits = _SLOT_BIT[_low_byte(level_codes) & 7]
             parents = level_codes >> _U(3)
-            slots = (level_codes & _U(7)).astype(np.uint8)
-            starts = np.flatnonzero(np.r_[True, parents[1:] != parents[:-1]]) if len(parents) \
-                else np.zeros(0, dtype=np.int64)
-            bits = np.left_shift(np.uint8(1), slots)
+            new_parent = np.empty(len(parents), dtype=bool)
+            new_parent[:1] = True
+            np.not_equal(parents[1:], parents[:-1], out=new_parent[1:])
+            starts = np.flatnonzero(new_parent)
+            del new_parent
             masks[level] = np.bitwise_or.reduceat(bits, starts) if len(bits) else \
                 np.zeros(0, dtype=np.uint8)
             if level < depth - 1:

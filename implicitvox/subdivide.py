@@ -58,7 +58,7 @@ def _states(flo: np.ndarray, fhi: np.ndarray) -> np.ndarray:
 
 def classify(func: Function, grid: Grid, level: int, coords: np.ndarray,
              exact: Optional[Callable[[np.ndarray, np.ndarray], np.ndarray]] = None,
-             mean_value: bool = True) -> np.ndarray:
+             mean_value: bool = False) -> np.ndarray:
     """States (int8) of octants ``coords`` at ``level``: EMPTY, FULL or AMBIGUOUS.
 
     The natural interval extension decides first; octants it leaves
@@ -88,24 +88,75 @@ def classify(func: Function, grid: Grid, level: int, coords: np.ndarray,
 def _children(grid: Grid, level: int, parents: np.ndarray) -> np.ndarray:
     """The 8 children of each parent at ``level + 1``, cropped to the grid."""
     kids = (parents[:, None, :] * 2 + _CHILD_OFFSETS[None, :, :]).reshape(-1, 3)
-    scale = 1 << (grid.depth - level - 1)
-    inside = np.all(kids * scale < np.asarray(grid.shape), axis=1)
-    return kids[inside]
+    inside = _inside(grid, level + 1, kids)
+    return kids if inside is None else kids[inside]
+
+
+def _inside(grid: Grid, level: int, octants: np.ndarray) -> Optional[np.ndarray]:
+    """Which octants at ``level`` meet the grid (None: all, the grid fills the octree)."""
+    if all(n == 1 << grid.depth for n in grid.shape):
+        return None
+    limits = [-(-n // (1 << (grid.depth - level))) for n in grid.shape]  # octants per axis
+    return (octants[:, 0] < limits[0]) & (octants[:, 1] < limits[1]) & (octants[:, 2] < limits[2])
+
+
+_BROADCAST = [(1, 1, 2, -1), (1, 2, 1, -1), (2, 1, 1, -1)]
+
+
+def _child_boxes(grid: Grid, level: int, parents: np.ndarray):
+    """Per-axis bounds of the children, shaped to broadcast: ``x (1, 1, 2, m)``,
+    ``y (1, 2, 1, m)``, ``z (2, 1, 1, m)``; the (2, 2, 2, m) result reshapes to
+    ``(8, m)`` in child order ``x + 2y + 4z``. Children past the grid get
+    degenerate boxes on its edge (they are dropped after)."""
+    scale = float(1 << (grid.depth - level - 1))
+    lo, hi = [], []
+    for a in range(3):
+        first = (parents[None, :, a].astype(np.float64) * 2.0 + _HALVES) * scale
+        last = np.minimum(first + scale, grid.shape[a])
+        first = np.minimum(first, grid.shape[a])
+        lo.append(grid.edge(a, first).reshape(_BROADCAST[a]))
+        hi.append(grid.edge(a, last).reshape(_BROADCAST[a]))
+    return tuple(lo), tuple(hi)
+
+
+_HALVES = np.array([[0.0], [1.0]])
+
+
+def classify_children(func: Function, grid: Grid, level: int, parents: np.ndarray,
+                      exact=None, mean_value: bool = False) -> tuple[np.ndarray, np.ndarray]:
+    """Children (8m - cropped, 3) of octants at ``level`` and their states.
+
+    One broadcast interval evaluation for all children (see
+    :func:`_child_boxes`); the mean value form and the exact test then run on
+    the AMBIGUOUS ones, as in :func:`classify`.
+    """
+    lo, hi = _child_boxes(grid, level, parents)
+    flo, fhi = func.interval_columns(lo, hi)
+    kids = (parents[None, :, :] * 2 + _CHILD_OFFSETS[:, None, :]).reshape(-1, 3)
+    state = _states(flo.reshape(-1), fhi.reshape(-1))
+    inside = _inside(grid, level + 1, kids)
+    if inside is not None:
+        kids, state = kids[inside], state[inside]
+    if mean_value or exact is not None:
+        amb = np.flatnonzero(state == AMBIGUOUS)
+        if amb.size:
+            state[amb] = classify(func, grid, level + 1, kids[amb], exact, mean_value)
+    return kids, state
 
 
 class _Progress:
     """Share of the estimated work done, reported non-decreasing.
 
     The number of octants to classify grows about 4 times per level near a
-    surface (Stolte §4.1.3), so a pending chunk of ``m`` octants at level ``l``
-    is estimated at ``m * (4**(depth - l + 1) - 1) / 3`` classifications.
+    surface (Stolte §4.1.3), so the children of ``m`` pending octants at level
+    ``l`` are estimated at ``8 m (4**(depth - l) - 1) / 3`` classifications.
     """
 
     def __init__(self, hook: Optional[Callable[[float], Any]], depth: int):
         self.hook, self.depth, self.done, self.last = hook, depth, 0, 0.0
 
     def estimate(self, m: int, level: int) -> float:
-        return m * (4.0 ** (self.depth - level + 1) - 1.0) / 3.0
+        return 8.0 * m * (4.0 ** (self.depth - level) - 1.0) / 3.0
 
     def report(self, stack: list) -> None:
         if self.hook is None:
@@ -118,7 +169,7 @@ class _Progress:
 
 def subdivide(func: Function, grid: Grid, *, start: Optional[tuple[int, np.ndarray]] = None,
               interior: bool = False, exact=None, progress=None, chunk: int = CHUNK,
-              mean_value: bool = True) -> Subdivision:
+              mean_value: bool = False) -> Subdivision:
     """Classify octants from the root (or from ``start``) down to the voxels.
 
     Parameters
@@ -128,8 +179,8 @@ def subdivide(func: Function, grid: Grid, *, start: Optional[tuple[int, np.ndarr
     grid : Grid
         The voxel grid; the octree has ``grid.depth`` levels below the root.
     start : (level, coords), optional
-        Octants to classify first (default: the root). ``Voxels.refine``
-        passes the stored surface voxels' children here.
+        AMBIGUOUS octants at ``level`` to continue from (default: classify the
+        root). ``Voxels.refine`` passes the stored surface voxels.
     interior : bool, default: False
         Record FULL octants.
     exact : callable, optional
@@ -137,40 +188,53 @@ def subdivide(func: Function, grid: Grid, *, start: Optional[tuple[int, np.ndarr
     progress : callable, optional
         Called with the estimated share of work done, in [0, 1].
     chunk : int
-        Octants per interval evaluation.
-    mean_value : bool, default: True
+        Octants classified per step (the children of ``chunk // 8`` parents).
+    mean_value : bool, default: False
         Tighten AMBIGUOUS octants with the mean value form.
     """
     depth = grid.depth
-    level0, coords0 = start if start is not None else (0, np.zeros((1, 3), dtype=np.int32))
-    stack: list[tuple[int, np.ndarray]] = [
-        (level0, coords0[s:s + chunk]) for s in range(0, max(len(coords0), 1), chunk)]
+    per_step = max(1, chunk // 8)
     surface: list[np.ndarray] = []
     interior_parts: dict[int, list[np.ndarray]] = {}
-    meter = _Progress(progress, depth)
+    stack: list[tuple[int, np.ndarray]] = []
     evaluated = 0
+    if start is None:
+        root = np.zeros((1, 3), dtype=np.int32)
+        state = classify(func, grid, 0, root, exact, mean_value)
+        evaluated = 1
+        if state[0] == FULL and interior:
+            interior_parts[0] = [root]
+        elif state[0] == AMBIGUOUS:
+            if depth == 0:
+                surface.append(root)
+            else:
+                stack.append((0, root))
+    else:
+        level0, coords0 = start
+        coords0 = np.asarray(coords0, dtype=np.int32).reshape(-1, 3)
+        stack.extend((level0, coords0[s:s + per_step]) for s in range(0, len(coords0), per_step))
+    meter = _Progress(progress, depth)
     while stack:
-        level, octants = stack.pop()
-        if len(octants) == 0:
-            continue
-        state = classify(func, grid, level, octants, exact, mean_value)
-        evaluated += len(octants)
-        meter.done += len(octants)
+        level, parents = stack.pop()
+        kids, state = classify_children(func, grid, level, parents, exact, mean_value)
+        evaluated += len(kids)
+        meter.done += len(kids)
         if interior:
-            full = octants[state == FULL]
+            full = kids[state == FULL]
             if len(full):
-                interior_parts.setdefault(level, []).append(full)
-        ambiguous = octants[state == AMBIGUOUS]
-        if level == depth:
+                interior_parts.setdefault(level + 1, []).append(full)
+        ambiguous = kids[state == AMBIGUOUS]
+        if level + 1 == depth:
             surface.append(ambiguous)
         elif len(ambiguous):
-            kids = _children(grid, level, ambiguous)
-            stack.extend((level + 1, kids[s:s + chunk]) for s in range(0, len(kids), chunk))
+            stack.extend((level + 1, ambiguous[s:s + per_step])
+                         for s in range(0, len(ambiguous), per_step))
         meter.report(stack)
+    if progress is not None:
+        progress(1.0)
     empty = np.zeros((0, 3), dtype=np.int32)
     return Subdivision(
-        surface=np.concatenate(surface).astype(np.int32) if surface else empty,
-        interior={lvl: np.concatenate(parts).astype(np.int32)
+        surface=np.concatenate(surface).astype(np.int32, copy=False) if surface else empty,
+        interior={lvl: np.concatenate(parts).astype(np.int32, copy=False)
                   for lvl, parts in sorted(interior_parts.items())},
         evaluated=evaluated)
-

@@ -16,7 +16,7 @@ CUBE = ((-1.0,) * 3, (1.0,) * 3)
 
 @pytest.mark.parametrize("shape, res, options", [
     (sinsin(3, 4), 16, {}), (gear(), 24, {}), (BALL, (10, 7, 12), {}),
-    (sinsin(3, 4), 16, {"subvoxel": 1}), (gear(), 16, {"mean_value": False}),
+    (sinsin(3, 4), 16, {"subvoxel": 1}), (gear(), 16, {"mean_value": True}),
 ])
 def test_refine_equals_direct_voxelization(shape, res, options):
     bounds = CUBE if shape is BALL else None
