@@ -118,6 +118,7 @@ def render(vox: Any, path: str, *, window_size: Sequence[int] = (1024, 768),
     plotter.camera_position = "iso"
     plotter.camera.elevation = 10
     plotter.reset_camera()
+    plotter.camera.zoom(1.3)
     plotter.screenshot(path)
     plotter.close()
     return path
