@@ -13,6 +13,8 @@ Examples
 1.0
 """
 from .expr import Expr, constant, wrap, x, y, z
+from .coords import (Cylindrical, Spherical, cylindrical, elevation, phi, r, radius, rho,
+                     spherical, theta)
 from .function import Function, compile
 from .grid import Grid
 from .io import load
@@ -28,6 +30,8 @@ __version__ = "0.1.0"
 __all__ = [
     "Expr", "constant", "wrap", "x", "y", "z",
     "Function", "compile",
+    "r", "rho", "theta", "phi", "spherical", "cylindrical", "Spherical", "Cylindrical",
+    "radius", "elevation",
     "voxelize", "Voxels", "Grid", "Octree", "PointerOctree", "load",
     "Shape", "EMPTY", "FULL", "AMBIGUOUS",
     "abs", "acos", "asin", "atan", "atan2", "clip", "cos", "exp", "floor", "hypot", "log",

@@ -324,3 +324,63 @@ def i_max(alo, ahi, blo, bhi):
 
 def i_floor(alo, ahi):
     return np.floor(alo), np.floor(ahi)
+
+
+# -- coordinates (Stolte §4.1.2) ---------------------------------------------------------
+def i_radius(ulo, uhi, vlo, vhi, wlo, whi):
+    """Distance to the origin over a box: from its nearest to its farthest point."""
+    lo = np.hypot(np.hypot(mignitude(ulo, uhi), mignitude(vlo, vhi)), mignitude(wlo, whi))
+    hi = np.hypot(np.hypot(magnitude(ulo, uhi), magnitude(vlo, vhi)), magnitude(wlo, whi))
+    return R.down_nonneg(lo, 2 * P), R.up_nonneg(hi, 2 * P)
+
+
+def i_elevation(ulo, uhi, vlo, vhi, wlo, whi):
+    """Elevation ``atan2(w, hypot(u, v))`` in ``[-pi/2, pi/2]`` over a box.
+
+    ``rho = hypot(u, v)`` ranges over ``[rho_lo, rho_hi]`` independently of
+    ``w``; the elevation grows with ``w`` and, for ``w > 0``, falls with
+    ``rho`` (rises for ``w < 0``): the extremes are at the corners
+    ``(rho_hi, w_lo)`` or ``(rho_lo, w_lo)``, and ``(rho_lo, w_hi)`` or
+    ``(rho_hi, w_hi)``, by the sign of ``w`` (Stolte Fig. 5). A box holding
+    the axis has ``rho_lo = 0``, giving ``+-pi/2`` as it should; the branch cut
+    of ``atan2`` is never met because ``rho >= 0``.
+    """
+    rlo = R.down_nonneg(np.hypot(mignitude(ulo, uhi), mignitude(vlo, vhi)), P)
+    rhi = R.up_nonneg(np.hypot(magnitude(ulo, uhi), magnitude(vlo, vhi)), P)
+    lo = np.arctan2(wlo, np.where(wlo >= 0.0, rhi, rlo))
+    hi = np.arctan2(whi, np.where(whi >= 0.0, rlo, rhi))
+    return np.maximum(R.down(lo, T), -HALF_PI_UP), np.minimum(R.up(hi, T), HALF_PI_UP)
+
+
+TWO_PI_UP = float(np.nextafter(2.0 * np.pi, INF))
+
+
+def angle_interval(vlo, vhi, ulo, uhi):
+    """``theta = atan2(v, u)`` over a box, unwrapped across the branch cut.
+
+    Returns ``(lo, hi, whole)``. A box that straddles the negative ``u`` axis
+    (the cut) gets ``[atan2(v_hi, u_hi), atan2(v_lo, u_hi) + 2 pi]``: an
+    interval that holds every angle of the box *modulo 2 pi*, so it is valid
+    only inside functions of period ``2 pi`` (``sin(k theta + c)`` with
+    integer ``k``). ``whole`` marks boxes that hold the origin (every angle).
+    """
+    lo, hi = i_atan2(vlo, vhi, ulo, uhi)
+    whole = (ulo <= 0.0) & (uhi >= 0.0) & (vlo <= 0.0) & (vhi >= 0.0)
+    cut = (uhi < 0.0) & (vlo <= 0.0) & (vhi >= 0.0)
+    if np.any(cut):
+        a = R.down(np.arctan2(vhi, uhi), T)
+        b = R.up(R.up(np.arctan2(vlo, uhi), T) + TWO_PI_UP)
+        lo = np.where(cut, a, lo)
+        hi = np.where(cut, b, hi)
+    return lo, hi, whole
+
+
+def i_periodic_angle(vlo, vhi, ulo, uhi, fn: str, k: float, c: float):
+    """``sin`` or ``cos`` of ``k * atan2(v, u) + c`` for an integer ``k``, tight
+    across the branch cut (see :func:`angle_interval`)."""
+    alo, ahi, whole = angle_interval(vlo, vhi, ulo, uhi)
+    alo, ahi = i_mulc(alo, ahi, k)
+    if c != 0.0:
+        alo, ahi = i_addc(alo, ahi, c)
+    lo, hi = (i_sin if fn == "sin" else i_cos)(alo, ahi)
+    return np.where(whole, -1.0, lo), np.where(whole, 1.0, hi)

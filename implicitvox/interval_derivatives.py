@@ -150,7 +150,42 @@ def _d_floor(v, g, out, p):
     return (zero, zero), np.floor(v[0][0]) != np.floor(v[0][1])
 
 
+def _d_radius(v, g, out, p):
+    num = I.i_add(*I.i_add(*I.i_mul(*v[0], *g[0]), *I.i_mul(*v[1], *g[1])),
+                  *I.i_mul(*v[2], *g[2]))
+    return I.i_div(*num, *out), None
+
+
+def _holds_origin(*intervals):
+    held = True
+    for lo, hi in intervals:
+        held = held & (lo <= 0.0) & (hi >= 0.0)
+    return held
+
+
+def _d_elevation(v, g, out, p):
+    u, vv, w = v
+    rho = I.i_hypot(*u, *vv)
+    drho = I.i_div(*I.i_add(*I.i_mul(*u, *g[0]), *I.i_mul(*vv, *g[1])), *rho)
+    num = I.i_sub(*I.i_mul(*rho, *g[2]), *I.i_mul(*w, *drho))
+    den = I.i_add(*I.i_square(*rho), *I.i_square(*w))
+    return I.i_div(*num, *den), _holds_origin(u, vv, w)
+
+
+def _d_periodic_angle(v, g, out, p):
+    fn, k, c = p
+    (vlo, vhi), (ulo, uhi) = v
+    other = "cos" if fn == "sin" else "sin"
+    slope = I.i_periodic_angle(vlo, vhi, ulo, uhi, other, k, c)
+    if fn == "cos":
+        slope = I.i_neg(*slope)
+    dtheta = I.i_div(*I.i_sub(*I.i_mul(ulo, uhi, *g[0]), *I.i_mul(vlo, vhi, *g[1])),
+                     *I.i_add(*I.i_square(ulo, uhi), *I.i_square(vlo, vhi)))
+    return I.i_mul(*I.i_mulc(*slope, k), *dtheta), _holds_origin(v[0], v[1])
+
+
 RULES = {
+    "radius": _d_radius, "elevation": _d_elevation, "periodic_angle": _d_periodic_angle,
     "add": _d_add, "sub": _d_sub, "mul": _d_mul, "div": _d_div,
     "neg": lambda v, g, o, p: (I.i_neg(*g[0]), None),
     "addc": lambda v, g, o, p: (g[0], None),

@@ -159,6 +159,36 @@ def _mp_atan2(a, p):
     return mpmath.atan2(a[0], a[1])
 
 
+def _d_elevation(v, g, o, p):
+    u, w = np.hypot(v[0], v[1]), v[2]
+    du = (v[0] * g[0] + v[1] * g[1]) / u
+    return (u * g[2] - w * du) / (u * u + w * w)
+
+
+def _mp_elevation(a, p):
+    rho = mpmath.sqrt(a[0] ** 2 + a[1] ** 2)
+    return mpmath.mpf(0) if rho == 0 and a[2] == 0 else mpmath.atan2(a[2], rho)
+
+
+def _point_periodic_angle(a, p):
+    fn, k, c = p
+    return (np.sin if fn == "sin" else np.cos)(k * np.arctan2(a[0], a[1]) + c)
+
+
+def _d_periodic_angle(v, g, o, p):
+    fn, k, c = p
+    vv, uu = v
+    angle = k * np.arctan2(vv, uu) + c
+    slope = np.cos(angle) if fn == "sin" else -np.sin(angle)
+    return slope * k * (uu * g[0] - vv * g[1]) / (uu * uu + vv * vv)
+
+
+def _mp_periodic_angle(a, p):
+    fn, k, c = p
+    angle = mpmath.mpf(0) if a[0] == 0 and a[1] == 0 else mpmath.atan2(a[0], a[1])
+    return (mpmath.sin if fn == "sin" else mpmath.cos)(k * angle + c)
+
+
 def _row(name, arity, point, interval, derivative, reference, **kw) -> Opcode:
     return Opcode(name, arity, point, interval, derivative, _mp_guard(reference),
                   interval_derivative=_INTERVAL_DERIVATIVES[name], **kw)
@@ -221,6 +251,17 @@ _ROWS = [
          lambda v, g, o, p: p * g[0], lambda a, p: a[0] * p, internal=True),
     _row("divc", 1, lambda a, p: a[0] / p, lambda lo, hi, p: I.i_divc(lo[0], hi[0], p),
          lambda v, g, o, p: g[0] / p, lambda a, p: a[0] / p, internal=True),
+    # Coordinates (Stolte §4.1.2); arguments (u, v, w), w along the axis.
+    _row("radius", 3, lambda a, p: np.hypot(np.hypot(a[0], a[1]), a[2]),
+         lambda lo, hi, p: I.i_radius(lo[0], hi[0], lo[1], hi[1], lo[2], hi[2]),
+         lambda v, g, o, p: (v[0] * g[0] + v[1] * g[1] + v[2] * g[2]) / o,
+         lambda a, p: mpmath.sqrt(a[0] ** 2 + a[1] ** 2 + a[2] ** 2)),
+    _row("elevation", 3, lambda a, p: np.arctan2(a[2], np.hypot(a[0], a[1])),
+         lambda lo, hi, p: I.i_elevation(lo[0], hi[0], lo[1], hi[1], lo[2], hi[2]),
+         _d_elevation, _mp_elevation),
+    _row("periodic_angle", 2, _point_periodic_angle,
+         lambda lo, hi, p: I.i_periodic_angle(lo[0], hi[0], lo[1], hi[1], *p),
+         _d_periodic_angle, _mp_periodic_angle, internal=True),
     _row("floor", 1, _un(np.floor), _iun(I.i_floor),
          lambda v, g, o, p: g[0] * 0.0, _mp_floor, exact=True),
 ]

@@ -136,6 +136,7 @@ def build_tape(expr: Expr) -> Tape:
             if (op.name == "mul" and args[0] == args[1]) or (op.name == "powi" and param == 2):
                 op, args, param = OPCODES["square"], args[:1], None
             op, args, param = _with_constant_operand(op, args, param, values)
+            op, args, param = _periodic_of_angle(op, args, param, values)
             if all(values[a].kind == "const" for a in args):
                 c = _fold(op, [values[a] for a in args], param)
                 key = ("const",) + tuple(float(t).hex() for t in c)
@@ -173,7 +174,26 @@ def _with_constant_operand(op: Opcode, args: tuple[int, ...], param: Any,
     return op, args, param
 
 
+def _periodic_of_angle(op: Opcode, args: tuple[int, ...], param: Any,
+                       values: list[_Value]) -> tuple[Opcode, tuple[int, ...], Any]:
+    """``sin``/``cos`` of ``k * atan2(v, u) + c`` (``k`` an integer) become one
+    ``periodic_angle`` node, tight across the branch cut
+    (:func:`implicitvox.interval.angle_interval`)."""
+    if op.name not in ("sin", "cos"):
+        return op, args, param
+    node, k, c = values[args[0]], 1.0, 0.0
+    if node.kind == "op" and node.op.name == "addc":
+        c, node = node.param, values[node.args[0]]
+    if node.kind == "op" and node.op.name == "mulc":
+        k, node = node.param, values[node.args[0]]
+    if node.kind != "op" or node.op.name != "atan2" or k != int(k) or not np.isfinite(c):
+        return op, args, param
+    return OPCODES["periodic_angle"], node.args, (op.name, float(k), float(c))
+
+
 def _param_key(param: Any) -> Any:
+    if isinstance(param, tuple):
+        return tuple(_param_key(p) for p in param)
     return param.hex() if isinstance(param, float) else param
 
 

@@ -39,6 +39,9 @@ def param_for(draw, name: str):
         return draw(st.integers(-5, 7))
     if name in ("addc", "rsubc", "mulc"):
         return draw(anywhere)
+    if name == "periodic_angle":
+        return (draw(st.sampled_from(["sin", "cos"])), float(draw(st.integers(-9, 9))),
+                draw(st.floats(-3.0, 3.0)))
     if name == "divc":
         return draw(anywhere.filter(lambda v: v != 0.0))
     if name == "powr":
@@ -58,6 +61,7 @@ def samples(lo: float, hi: float, rng: np.random.Generator, n_interior: int) -> 
 UNARY = ["neg", "square", "sqrt", "abs", "exp", "log", "sin", "cos", "tan", "atan", "asin",
          "acos", "floor"]
 BINARY = ["add", "sub", "mul", "div", "atan2", "hypot", "min", "max"]
+TERNARY = ["radius", "elevation"]
 LEAVES = st.one_of(st.sampled_from([ivx.x, ivx.y, ivx.z]),
                    st.floats(-3.0, 3.0).map(ivx.constant))
 
@@ -68,7 +72,7 @@ def expression(draw, depth: int, unary=tuple(UNARY), binary=tuple(BINARY),
     """An expression exactly ``depth`` levels deep (a leaf has depth 0)."""
     if depth == 0:
         return draw(LEAVES)
-    kinds = ["unary", "binary"] + (["powi", "powr"] if powers else [])
+    kinds = ["unary", "binary"] + (["powi", "powr", "ternary"] if powers else [])
     kind = draw(st.sampled_from(kinds))
     if kind == "unary":
         return Expr(draw(st.sampled_from(list(unary))), (draw(expression(depth - 1, unary,
@@ -76,6 +80,11 @@ def expression(draw, depth: int, unary=tuple(UNARY), binary=tuple(BINARY),
     if kind == "powi":
         return Expr("powi", (draw(expression(depth - 1, unary, binary, powers)),),
                     draw(st.integers(-3, 4).filter(lambda n: n != 1)))
+    if kind == "ternary":
+        parts = [draw(expression(draw(st.integers(0, depth - 1)), unary, binary, powers))
+                 for _ in range(2)] + [draw(expression(depth - 1, unary, binary, powers))]
+        order = draw(st.permutations(parts))
+        return Expr(draw(st.sampled_from(TERNARY)), tuple(order))
     if kind == "powr":
         return Expr("powr", (draw(expression(depth - 1, unary, binary, powers)),),
                     draw(param_for("powr")))

@@ -178,6 +178,8 @@ def test_nested_expressions_hold_mpmath_iv_interval(expr, box):
 
 def test_binary_strategy_covers_every_binary_opcode():
     unary_ops = {n for n, op in OPCODES.items() if op.arity == 1 and not op.internal}
-    assert set(BINARY) == {n for n, op in OPCODES.items() if op.arity == 2}
+    assert set(BINARY) == {n for n, op in OPCODES.items() if op.arity == 2 and not op.internal}
+    from tests.strategies import TERNARY
+    assert set(TERNARY) == {n for n, op in OPCODES.items() if op.arity == 3}
     from tests.strategies import UNARY
     assert set(UNARY) | {"powi", "powr"} == unary_ops
