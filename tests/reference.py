@@ -12,6 +12,9 @@ DPS = 60
 #: need pi to thousands of digits); the per-opcode tests cover them up to 1e15.
 PERIODIC_LIMIT = mpmath.mpf(10) ** 15
 _PERIODIC = {"sin", "cos", "tan"}
+#: exp of larger arguments is not checked pointwise either (mpmath would need
+#: ln 2 to as many digits); the per-opcode tests cover exp on [-800, 800].
+EXP_LIMIT = mpmath.mpf(10) ** 4
 
 
 def mp_value(expr: Expr, point, dps: int = DPS):
@@ -29,6 +32,8 @@ def mp_value(expr: Expr, point, dps: int = DPS):
                 if any(a is None for a in args):
                     v = None
                 elif node.op in _PERIODIC and abs(args[0]) > PERIODIC_LIMIT:
+                    v = None
+                elif node.op == "exp" and abs(args[0]) > EXP_LIMIT:
                     v = None
                 else:
                     v = OPCODES[node.op].reference(args, node.param)
