@@ -20,6 +20,7 @@ from .grid import Grid
 from .io import load
 from .octree import Octree, PointerOctree
 from .shape import AMBIGUOUS, EMPTY, FULL, Shape
+from .sweep import repeat, repeat_polar
 from .voxelize import voxelize
 from .voxels import Voxels
 from .functions import (abs, acos, asin, atan, atan2, clip, cos, exp, floor, hypot, log,
@@ -31,7 +32,7 @@ __all__ = [
     "Expr", "constant", "wrap", "x", "y", "z",
     "Function", "compile",
     "r", "rho", "theta", "phi", "spherical", "cylindrical", "Spherical", "Cylindrical",
-    "radius", "elevation",
+    "radius", "elevation", "repeat", "repeat_polar",
     "voxelize", "Voxels", "Grid", "Octree", "PointerOctree", "load",
     "Shape", "EMPTY", "FULL", "AMBIGUOUS",
     "abs", "acos", "asin", "atan", "atan2", "clip", "cos", "exp", "floor", "hypot", "log",

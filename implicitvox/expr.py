@@ -347,12 +347,28 @@ def _node_source(node: Expr, parts: list[tuple[str, int]],
         if op == "powi" and p < 0:
             exponent = f"({p})"
         return (a if pa > _PREC_POW else f"({a})") + " ** " + exponent, _PREC_POW
+    if op == "repeat":
+        child, spacing, count = node.param
+        return (f"repeat({_to_source(child)}, spacing={spacing!r}, count={count!r})"
+                f"{_remapped(parts)}", _PREC_ATOM)
+    if op == "repeat_polar":
+        child, n, axis = node.param
+        return f"repeat_polar({_to_source(child)}, {n}, axis={axis!r}){_remapped(parts)}", \
+            _PREC_ATOM
     name = _FUNCTION_NAMES.get(op, op)
     extra = [] if node.param is None else [repr(node.param)]
     return f"{name}({', '.join([p for p, _ in parts] + extra)})", _PREC_ATOM
 
 
 _FUNCTION_NAMES = {"min": "min", "max": "max"}
+
+
+def _remapped(parts: list[tuple[str, int]]) -> str:
+    """``.remap(...)`` for a sweep read at coordinates other than x, y, z."""
+    names = [p for p, _ in parts]
+    if names == list(VARIABLES):
+        return ""
+    return ".remap(" + ", ".join(f"{v}={p}" for v, p in zip(VARIABLES, names) if p != v) + ")"
 
 
 def _to_source(expr: Expr) -> str:

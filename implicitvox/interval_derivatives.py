@@ -185,6 +185,8 @@ def _d_periodic_angle(v, g, out, p):
 
 
 RULES = {
+    "repeat": lambda v, g, o, p: p.interval_derivative(v, g, o, p),
+    "repeat_polar": lambda v, g, o, p: p.interval_derivative(v, g, o, p),
     "radius": _d_radius, "elevation": _d_elevation, "periodic_angle": _d_periodic_angle,
     "add": _d_add, "sub": _d_sub, "mul": _d_mul, "div": _d_div,
     "neg": lambda v, g, o, p: (I.i_neg(*g[0]), None),

@@ -20,7 +20,7 @@ Examples
 >>> OPCODES["sin"].arity
 1
 >>> sorted(name for name, op in OPCODES.items() if op.domain)
-['acos', 'asin', 'log', 'powr', 'sqrt']
+['acos', 'asin', 'log', 'powr', 'repeat', 'repeat_polar', 'sqrt']
 """
 from __future__ import annotations
 
@@ -53,6 +53,8 @@ class Opcode:
     internal: bool = False
     #: interval chain rule (:mod:`implicitvox.interval_derivatives`), for the mean value form
     interval_derivative: Callable[..., Any] | None = None
+    #: turns the expression's parameter into the tape's (sweeps compile their model)
+    prepare: Callable[[Any], Any] | None = None
 
 
 def _un(f):
@@ -189,6 +191,13 @@ def _mp_periodic_angle(a, p):
     return (mpmath.sin if fn == "sin" else mpmath.cos)(k * angle + c)
 
 
+def prepared(op: str, param: Any) -> Any:
+    """The compiled sweep of a ``repeat``/``repeat_polar`` parameter (imported
+    late: sweeps evaluate tapes, which read this table)."""
+    from .sweep import prepared as compiled
+    return compiled(op, param)
+
+
 def _row(name, arity, point, interval, derivative, reference, **kw) -> Opcode:
     return Opcode(name, arity, point, interval, derivative, _mp_guard(reference),
                   interval_derivative=_INTERVAL_DERIVATIVES[name], **kw)
@@ -262,6 +271,15 @@ _ROWS = [
     _row("periodic_angle", 2, _point_periodic_angle,
          lambda lo, hi, p: I.i_periodic_angle(lo[0], hi[0], lo[1], hi[1], *p),
          _d_periodic_angle, _mp_periodic_angle, internal=True),
+    # Replication sweeps (Stolte §3): the parameter is the compiled sweep.
+    _row("repeat", 3, lambda a, p: p.point(a, p), lambda lo, hi, p: p.interval(lo, hi, p),
+         lambda v, g, o, p: p.derivative(v, g, o, p),
+         lambda a, p: prepared("repeat", p).reference(a, p), domain=True,
+         prepare=lambda param: prepared("repeat", param)),
+    _row("repeat_polar", 3, lambda a, p: p.point(a, p), lambda lo, hi, p: p.interval(lo, hi, p),
+         lambda v, g, o, p: p.derivative(v, g, o, p),
+         lambda a, p: prepared("repeat_polar", p).reference(a, p), domain=True,
+         prepare=lambda param: prepared("repeat_polar", param)),
     _row("floor", 1, _un(np.floor), _iun(I.i_floor),
          lambda v, g, o, p: g[0] * 0.0, _mp_floor, exact=True),
 ]

@@ -132,7 +132,7 @@ def build_tape(expr: Expr) -> Tape:
                 raise ValueError(f"unknown opcode {node.op!r} in expression")
             op = OPCODES[node.op]
             args = tuple(index_of_node[id(a)] for a in node.args)
-            param = node.param
+            param = op.prepare(node.param) if op.prepare else node.param
             if (op.name == "mul" and args[0] == args[1]) or (op.name == "powi" and param == 2):
                 op, args, param = OPCODES["square"], args[:1], None
             op, args, param = _with_constant_operand(op, args, param, values)
@@ -192,6 +192,8 @@ def _periodic_of_angle(op: Opcode, args: tuple[int, ...], param: Any,
 
 
 def _param_key(param: Any) -> Any:
+    if hasattr(param, "key"):
+        return param.key()
     if isinstance(param, tuple):
         return tuple(_param_key(p) for p in param)
     return param.hex() if isinstance(param, float) else param

@@ -5,40 +5,15 @@ import mpmath
 from mpmath import iv
 
 from implicitvox.expr import Expr
-from implicitvox.opcodes import OPCODES
+
+from implicitvox.reference import mp_evaluate
 
 DPS = 60
-#: periodic functions of larger arguments are not checked pointwise (mpmath would
-#: need pi to thousands of digits); the per-opcode tests cover them up to 1e15.
-PERIODIC_LIMIT = mpmath.mpf(10) ** 15
-_PERIODIC = {"sin", "cos", "tan"}
-#: exp of larger arguments is not checked pointwise either (mpmath would need
-#: ln 2 to as many digits); the per-opcode tests cover exp on [-800, 800].
-EXP_LIMIT = mpmath.mpf(10) ** 4
 
 
 def mp_value(expr: Expr, point, dps: int = DPS):
     """Exact (to ``dps`` digits) value of ``expr`` at ``point``; None where undefined."""
-    with mpmath.workdps(dps):
-        vals = {}
-        coords = dict(zip("xyz", (c if isinstance(c, mpmath.mpf) else mpmath.mpf(float(c)) for c in point)))
-        for node in expr.walk():
-            if node.op == "var":
-                v = coords[node.param]
-            elif node.op == "const":
-                v = mpmath.mpf(node.param)
-            else:
-                args = [vals[id(a)] for a in node.args]
-                if any(a is None for a in args):
-                    v = None
-                elif node.op in _PERIODIC and abs(args[0]) > PERIODIC_LIMIT:
-                    v = None
-                elif node.op == "exp" and abs(args[0]) > EXP_LIMIT:
-                    v = None
-                else:
-                    v = OPCODES[node.op].reference(args, node.param)
-            vals[id(node)] = v
-        return vals[id(expr)]
+    return mp_evaluate(expr, point, dps)
 
 
 def contains(lo: float, hi: float, value) -> bool:

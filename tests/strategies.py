@@ -39,6 +39,9 @@ def param_for(draw, name: str):
         return draw(st.integers(-5, 7))
     if name in ("addc", "rsubc", "mulc"):
         return draw(anywhere)
+    if name in ("repeat", "repeat_polar"):
+        from implicitvox.opcodes import prepared
+        return prepared(name, draw(sweep_param(name)))
     if name == "periodic_angle":
         return (draw(st.sampled_from(["sin", "cos"])), float(draw(st.integers(-9, 9))),
                 draw(st.floats(-3.0, 3.0)))
@@ -67,12 +70,25 @@ LEAVES = st.one_of(st.sampled_from([ivx.x, ivx.y, ivx.z]),
 
 
 @st.composite
+def sweep_param(draw, name: str):
+    """The expression parameter of a sweep node: a small child model and its layout."""
+    child = draw(expression(2))
+    if name == "repeat_polar":
+        return (child, draw(st.integers(1, 12)), draw(st.sampled_from(["x", "y", "z"])))
+    spacing = tuple(draw(st.one_of(st.none(), st.floats(0.1, 2.0))) for _ in range(3))
+    if all(v is None for v in spacing):
+        spacing = (0.5, None, None)
+    count = tuple(draw(st.one_of(st.none(), st.integers(1, 5))) for _ in range(3))
+    return (child, spacing, count)
+
+
+@st.composite
 def expression(draw, depth: int, unary=tuple(UNARY), binary=tuple(BINARY),
                powers: bool = True) -> Expr:
     """An expression exactly ``depth`` levels deep (a leaf has depth 0)."""
     if depth == 0:
         return draw(LEAVES)
-    kinds = ["unary", "binary"] + (["powi", "powr", "ternary"] if powers else [])
+    kinds = ["unary", "binary"] + (["powi", "powr", "ternary", "sweep"] if powers else [])
     kind = draw(st.sampled_from(kinds))
     if kind == "unary":
         return Expr(draw(st.sampled_from(list(unary))), (draw(expression(depth - 1, unary,
@@ -80,6 +96,11 @@ def expression(draw, depth: int, unary=tuple(UNARY), binary=tuple(BINARY),
     if kind == "powi":
         return Expr("powi", (draw(expression(depth - 1, unary, binary, powers)),),
                     draw(st.integers(-3, 4).filter(lambda n: n != 1)))
+    if kind == "sweep":
+        name = draw(st.sampled_from(["repeat", "repeat_polar"]))
+        coords = tuple(draw(expression(draw(st.integers(0, depth - 1)), unary, binary, False))
+                       for _ in range(3))
+        return Expr(name, coords, draw(sweep_param(name)))
     if kind == "ternary":
         parts = [draw(expression(draw(st.integers(0, depth - 1)), unary, binary, powers))
                  for _ in range(2)] + [draw(expression(depth - 1, unary, binary, powers))]
