@@ -7,7 +7,7 @@ Examples
 --------
 >>> from implicitvox.examples import EXAMPLES, example
 >>> sorted(EXAMPLES)[:3]
-['blobby', 'gear', 'lobed-plate']
+['blobby', 'flange', 'gear']
 >>> example("gear").bounds
 ((-1.0, -0.3, -1.0), (1.0, 0.3, 1.0))
 """
@@ -17,33 +17,27 @@ from typing import Callable
 
 import numpy as np
 
+from .coords import cylindrical, spherical
 from .expr import Expr, x, y, z
-from .functions import atan2, exp, floor, hypot, max, min, sin, sqrt
+from .functions import exp, max, min, sin, sqrt
 from .shape import ExprShape
+from .sweep import repeat, repeat_polar
 
-__all__ = ["EXAMPLES", "example", "sinsin", "gear", "replicated_torus", "blobby", "lobed_plate"]
-
-
-def _theta_phi_r() -> tuple[Expr, Expr, Expr]:
-    """Stolte's spherical coordinates about the y axis (§4.1.2): theta in the
-    XZ plane, phi the elevation towards y, r the distance to the origin."""
-    theta = atan2(z, x)
-    phi = atan2(y, hypot(x, z))
-    r = sqrt(x * x + y * y + z * z)
-    return theta, phi, r
+__all__ = ["EXAMPLES", "example", "sinsin", "gear", "replicated_torus", "flange", "blobby",
+           "lobed_plate"]
 
 
 def sinsin(n: int, m: int) -> ExprShape:
-    """``sin(n theta) sin(m phi) - r`` (Stolte Fig. 6 and Fig. 11)."""
-    theta, phi, r = _theta_phi_r()
+    """``sin(n theta) sin(m phi) - r`` (Stolte Fig. 6 and Fig. 11), in Stolte's
+    spherical coordinates about y (§4.1.2)."""
+    r, theta, phi = spherical(axis="y")
     return ExprShape(sin(n * theta) * sin(m * phi) - r, ((-1.1,) * 3, (1.1,) * 3))
 
 
 def gear(teeth: int = 32) -> ExprShape:
     """Stolte's gear (Fig. 11-c): teeth ``rho - (0.8 + 0.05 sin(32 theta))`` in
     cylindrical coordinates about y, cut to a slab, with a hub and a bore."""
-    rho = hypot(x, z)
-    theta = atan2(z, x)
+    rho, theta, _ = cylindrical(axis="y")
     rim = max(rho - (0.8 + 0.05 * sin(teeth * theta)), abs(y) - 0.1)
     hub = max(rho - 0.3, abs(y) - 0.25)
     disc = min(rim, hub)
@@ -52,12 +46,22 @@ def gear(teeth: int = 32) -> ExprShape:
 
 
 def replicated_torus(spacing: float = 0.5, big: float = 0.6, small: float = 0.12) -> ExprShape:
-    """Stolte §3, eq. 3: a torus about z repeated along z every ``spacing``
-    (the replication factor is ``floor(z / b + 1/2)``)."""
-    i = floor(z / spacing + 0.5)
-    zz = z - spacing * i
-    return ExprShape((hypot(x, y) - big) ** 2 + zz ** 2 - small ** 2,
+    """Stolte §3, eq. 3: a torus about z repeated along z every ``spacing``,
+    without end (:func:`implicitvox.repeat`)."""
+    rho = cylindrical(axis="z").rho
+    torus = (rho - big) ** 2 + z ** 2 - small ** 2
+    return ExprShape(repeat(torus, spacing=(None, None, spacing)),
                      ((-0.9, -0.9, -1.5), (0.9, 0.9, 1.5)))
+
+
+def flange(bolts: int = 8) -> ExprShape:
+    """A flange with a bolt circle: a disc minus a bore minus ``bolts`` holes
+    (:func:`implicitvox.repeat_polar`)."""
+    rho = cylindrical(axis="z").rho
+    disc = max(rho - 1.0, abs(z) - 0.12)
+    hole = 0.09 - sqrt((x - 0.72) ** 2 + y ** 2)
+    return ExprShape(max(disc, 0.35 - rho, repeat_polar(hole, bolts)),
+                     ((-1.05, -1.05, -0.2), (1.05, 1.05, 0.2)))
 
 
 def blobby(n: int = 6, seed: int = 3, threshold: float = 0.5) -> ExprShape:
@@ -71,8 +75,7 @@ def blobby(n: int = 6, seed: int = 3, threshold: float = 0.5) -> ExprShape:
 
 def lobed_plate() -> ExprShape:
     """Stolte Fig. 11-d: contour ``rho - (1.2 + 0.05 sin(3 theta))`` cut to a plate."""
-    rho = hypot(x, z)
-    theta = atan2(z, x)
+    rho, theta, _ = cylindrical(axis="y")
     return ExprShape(max(rho - (1.2 + 0.05 * sin(3 * theta)), abs(y) - 0.15, 0.4 - rho),
                      ((-1.3, -0.2, -1.3), (1.3, 0.2, 1.3)))
 
@@ -89,7 +92,8 @@ EXAMPLES: dict[str, tuple[str, Callable[[], ExprShape]]] = {
     "sinsin918": ("sin(9 theta) sin(18 phi) - r (Stolte Fig. 6, Fig. 11)", lambda: sinsin(9, 18)),
     "gear": ("32-tooth gear in cylindrical coordinates (Stolte Fig. 11-c)", gear),
     "lobed-plate": ("rho - (1.2 + 0.05 sin(3 theta)) plate (Stolte Fig. 11-d)", lobed_plate),
-    "torus-sweep": ("torus replicated along z (Stolte §3, Fig. 2)", replicated_torus),
+    "torus-sweep": ("torus replicated along z without end (Stolte §3, Fig. 2)", replicated_torus),
+    "flange": ("a flange with a bolt circle (repeat_polar)", flange),
     "blobby": ("six blobby spheres (sum of Gaussians)", blobby),
     "sphere": ("the unit sphere", _sphere),
 }

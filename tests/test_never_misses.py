@@ -68,6 +68,10 @@ MODELS = {
     "csg-box-minus-ball": lambda: (max(max(abs(x), abs(y), abs(z)) - 0.6,
                                        0.75 - sqrt(x * x + y * y + z * z)), CUBE, None),
     "replicated-torus": lambda: _shape(replicated_torus()),
+    "repeat-torus": lambda: (ivx.repeat((hypot(x, y) - 0.6) ** 2 + z ** 2 - 0.15 ** 2,
+                                        spacing=(None, None, 0.37)), CUBE, None),
+    "polar-teeth": lambda: (max(ivx.repeat_polar(sqrt((x - 0.7) ** 2 + y ** 2) - 0.08, 9),
+                                abs(z) - 0.3), CUBE, None),
     "lobed-plate": lambda: _shape(lobed_plate()),
 }
 
