@@ -280,8 +280,14 @@ class PolarSweep:
         """Box turned back by ``k`` steps (interval rotation, Stolte §2)."""
         angle = k * self.step
         c, s = np.cos(angle), np.sin(angle)
-        clo, chi = R.down(c, 2 * R.TRANSCENDENTAL_ULPS), R.up(c, 2 * R.TRANSCENDENTAL_ULPS)
-        slo, shi = R.down(s, 2 * R.TRANSCENDENTAL_ULPS), R.up(s, 2 * R.TRANSCENDENTAL_ULPS)
+        # The float angle is off the exact k * 2 pi / n by a few ulps of the angle;
+        # cos and sin move at most that much (slope <= 1), an *absolute* error
+        # (sin(float(pi)) is 1.2e-16, not 0), so widen by it as well as by the
+        # functions' own relative error.
+        slack = np.abs(angle) * (8 * 2.0 ** -52) + 2.0 ** -1000
+        ulps = 2 * R.TRANSCENDENTAL_ULPS
+        clo, chi = R.down(c, ulps) - slack, R.up(c, ulps) + slack
+        slo, shi = R.down(s, ulps) - slack, R.up(s, ulps) + slack
         lu = I.i_add(*I.i_mul(ulo, uhi, clo, chi), *I.i_mul(vlo, vhi, slo, shi))
         lv = I.i_sub(*I.i_mul(vlo, vhi, clo, chi), *I.i_mul(ulo, uhi, slo, shi))
         return lu, lv
