@@ -18,7 +18,7 @@ from typing import Callable
 import numpy as np
 
 from .coords import cylindrical, spherical
-from .expr import Expr, x, y, z
+from .expr import x, y, z
 from .functions import exp, max, min, sin, sqrt
 from .shape import ExprShape
 from .sweep import repeat, repeat_polar

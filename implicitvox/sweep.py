@@ -30,7 +30,7 @@ from __future__ import annotations
 
 import functools
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields
 from typing import Any, Sequence
 
 import mpmath
@@ -106,23 +106,34 @@ def repeat_polar(expr: Any, n: int, axis: str = "z") -> Expr:
 
 
 # -- runtime forms (the tape's instruction parameters) -------------------------------
+def _columns(arrays: Sequence[Any]) -> tuple[tuple[int, ...], list[np.ndarray]]:
+    """The broadcast shape of the arguments and each flattened to it."""
+    shape = np.broadcast_shapes(*(np.shape(a) for a in arrays))
+    return shape, [np.broadcast_to(a, shape).reshape(-1) for a in arrays]
+
+
+class _Compiled:
+    """A sweep's expression parameter ``(expr, ...)`` with the model's tape
+    compiled once; the tape interns it by :meth:`key`."""
+
+    @classmethod
+    def prepare(cls, param: tuple):
+        from .tape import build_tape
+        return cls(*param, build_tape(param[0]))
+
+    def key(self) -> tuple:
+        return (type(self).__name__,) + tuple(
+            getattr(self, f.name) for f in fields(self) if f.name != "tape")
+
+
 @dataclass(frozen=True, eq=False)
-class Sweep:
+class Sweep(_Compiled):
     """A compiled :func:`repeat`: the child's tape, spacing and counts."""
 
     expr: Expr
     spacing: tuple
     count: tuple
     tape: Any = field(repr=False)
-
-    @classmethod
-    def prepare(cls, param: tuple) -> "Sweep":
-        from .tape import build_tape
-        expr, spacing, count = param
-        return cls(expr, spacing, count, build_tape(expr))
-
-    def key(self) -> tuple:
-        return ("repeat", self.expr, self.spacing, self.count)
 
     # instance index of coordinates (numpy), clamped to the count
     def _index(self, axis: int, t: np.ndarray, slack: float = 0.0) -> np.ndarray:
@@ -132,8 +143,7 @@ class Sweep:
         return k if n is None else np.clip(k, 0, n - 1)
 
     def point(self, args: tuple, p: Any) -> np.ndarray:
-        shape = np.broadcast_shapes(*(np.shape(a) for a in args))
-        cols = [np.broadcast_to(a, shape).reshape(-1) for a in args]
+        shape, cols = _columns(args)
         local = [c if self.spacing[a] is None else c - self._index(a, c) * self.spacing[a]
                  for a, c in enumerate(cols)]
         return evaluate_points(self.tape, *local).reshape(shape)
@@ -163,9 +173,8 @@ class Sweep:
         return (a_lo, a_hi), (b_lo, b_hi), ~same
 
     def interval(self, los: tuple, his: tuple, p: Any):
-        shape = np.broadcast_shapes(*(np.shape(a) for a in los + his))
-        lo = [np.broadcast_to(a, shape).reshape(-1) for a in los]
-        hi = [np.broadcast_to(a, shape).reshape(-1) for a in his]
+        shape, cols = _columns(los + his)
+        lo, hi = cols[:3], cols[3:]
         options = []
         for a in range(3):
             if self.spacing[a] is None:
@@ -223,22 +232,13 @@ class Sweep:
 
 
 @dataclass(frozen=True, eq=False)
-class PolarSweep:
+class PolarSweep(_Compiled):
     """A compiled :func:`repeat_polar`."""
 
     expr: Expr
     n: int
     axis: str
     tape: Any = field(repr=False)
-
-    @classmethod
-    def prepare(cls, param: tuple) -> "PolarSweep":
-        from .tape import build_tape
-        expr, n, axis = param
-        return cls(expr, n, axis, build_tape(expr))
-
-    def key(self) -> tuple:
-        return ("repeat_polar", self.expr, self.n, self.axis)
 
     @property
     def step(self) -> float:
@@ -260,8 +260,7 @@ class PolarSweep:
         return u * c + v * s, v * c - u * s, c, s
 
     def point(self, args: tuple, p: Any) -> np.ndarray:
-        shape = np.broadcast_shapes(*(np.shape(a) for a in args))
-        cols = [np.broadcast_to(a, shape).reshape(-1) for a in args]
+        shape, cols = _columns(args)
         u, v, w = self._uvw(cols)
         lu, lv, _, _ = self._turn(u, v)
         return evaluate_points(self.tape, *self._xyz(lu, lv, w)).reshape(shape)
@@ -304,9 +303,8 @@ class PolarSweep:
         return (R.down_nonneg(rlo * c), rhi), (-R.up_nonneg(rhi * s), R.up_nonneg(rhi * s))
 
     def interval(self, los: tuple, his: tuple, p: Any):
-        shape = np.broadcast_shapes(*(np.shape(a) for a in los + his))
-        lo = [np.broadcast_to(a, shape).reshape(-1) for a in los]
-        hi = [np.broadcast_to(a, shape).reshape(-1) for a in his]
+        shape, cols = _columns(los + his)
+        lo, hi = cols[:3], cols[3:]
         (ulo, vlo, wlo), (uhi, vhi, whi) = self._uvw(lo), self._uvw(hi)
         alo, ahi, whole = I.angle_interval(vlo, vhi, ulo, uhi)
         k0 = np.floor(alo / self.step + 0.5 - 1e-9)

@@ -8,7 +8,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import implicitvox as ivx
-from implicitvox import cos, sin, x, y, z
+from implicitvox import cos, sin
 from tests.reference import contains, mp_value
 
 

@@ -162,7 +162,10 @@ def test_nested_expressions_hold_mpmath_iv_interval(expr, box):
     lo, hi = box
     f = ivx.compile(expr)
     flo, fhi = (float(v[0]) for v in f.interval([lo], [hi]))
-    ref = iv_interval(expr, lo, hi)
+    try:
+        ref = iv_interval(expr, lo, hi)
+    except OverflowError:  # mpmath's iv.exp of an enormous interval; nothing to compare
+        assume(False)
     # Where iv went unbounded (a division by an interval holding 0) the
     # conventions differ: iv keeps 0 * [-inf, inf] = [-inf, inf], ours reads
     # the endpoints as reals and gives 0. Containment is then checked by the
