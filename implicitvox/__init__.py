@@ -21,7 +21,7 @@ from .io import load
 from .octree import Octree, PointerOctree
 from .shape import AMBIGUOUS, EMPTY, FULL, Shape
 from .sweep import repeat, repeat_polar
-from .voxelize import voxelize
+from .voxelizer import voxelize
 from .voxels import Voxels
 from .functions import (abs, acos, asin, atan, atan2, clip, cos, exp, floor, hypot, log,
                         max, min, sin, sqrt, square, tan)

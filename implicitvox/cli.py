@@ -111,7 +111,7 @@ def _check_writable(path: Optional[str], what: str) -> None:
 
 def _voxelize(args: argparse.Namespace) -> int:
     from .examples import example
-    from .voxelize import voxelize
+    from .voxelizer import voxelize
 
     if (args.model is None) == (args.example is None):
         raise ModelError("give a model file or --example NAME (one of them)")

@@ -192,8 +192,6 @@ class Octree:
             if level < self.depth - 1:
                 node = self.first[level][node].astype(np.int64) + _BELOW[mask, slot]
         found[idx] = True
-        if self.depth == 0:
-            found[idx] = True
         return found
 
     def __repr__(self) -> str:

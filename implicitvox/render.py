@@ -54,7 +54,7 @@ def _shading(vox: Any, light: np.ndarray) -> Optional[np.ndarray]:
     normals = vox.normals
     if normals is None and getattr(vox, "_shape", None) is not None and vox.count:
         from .function import Function
-        from .voxelize import _compute_normals
+        from .voxelizer import _compute_normals
         normals = _compute_normals(Function(vox._shape.expr), vox.grid, vox.coords())
     if normals is None:
         return None

@@ -150,7 +150,7 @@ class Voxels:
         """Continue the subdivision ``levels`` more levels (Stolte §1: "continued
         from that point"): the result equals a direct voxelization at
         ``2**levels`` times the resolution."""
-        from .voxelize import refine_voxels
+        from .voxelizer import refine_voxels
         return refine_voxels(self, levels, progress=progress)
 
     # -- outputs ------------------------------------------------------------------------
