@@ -6,7 +6,7 @@ from mpmath import iv
 
 from implicitvox.expr import Expr
 
-from implicitvox.reference import mp_evaluate
+from implicitvox.reference import EXP_LIMIT, PERIODIC_LIMIT, mp_evaluate
 
 DPS = 60
 
@@ -21,8 +21,19 @@ def contains(lo: float, hi: float, value) -> bool:
     return mpmath.mpf(lo) <= value <= mpmath.mpf(hi)
 
 
-def _iv_endpoints(f, a):
-    return iv.mpf([f(a.a), f(a.b)])
+def _iv_periodic(f, a):
+    """iv.sin/cos, but [-1, 1] for arguments beyond 1e15 (mpmath would compute pi
+    to thousands of digits; our kernel also returns [-1, 1] there)."""
+    if max(abs(a.a), abs(a.b)) > PERIODIC_LIMIT:
+        return iv.mpf([-1, 1])
+    return f(a)
+
+
+def _iv_exp(a):
+    """iv.exp, refusing arguments beyond 1e4 (ln 2 to as many digits)."""
+    if max(abs(a.a), abs(a.b)) > EXP_LIMIT:
+        raise OverflowError("exp argument too large to compare")
+    return iv.exp(a)
 
 
 IV_OPS = {
@@ -33,9 +44,9 @@ IV_OPS = {
     "neg": lambda a, p: -a[0],
     "square": lambda a, p: a[0] ** 2,
     "powi": lambda a, p: a[0] ** p,
-    "exp": lambda a, p: iv.exp(a[0]),
-    "sin": lambda a, p: iv.sin(a[0]),
-    "cos": lambda a, p: iv.cos(a[0]),
+    "exp": lambda a, p: _iv_exp(a[0]),
+    "sin": lambda a, p: _iv_periodic(iv.sin, a[0]),
+    "cos": lambda a, p: _iv_periodic(iv.cos, a[0]),
     "abs": lambda a, p: abs(a[0]),
     "min": lambda a, p: iv.mpf([min(a[0].a, a[1].a), min(a[0].b, a[1].b)]),
     "max": lambda a, p: iv.mpf([max(a[0].a, a[1].a), max(a[0].b, a[1].b)]),
