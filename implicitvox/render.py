@@ -118,7 +118,9 @@ def render(vox: Any, path: str, *, window_size: Sequence[int] = (1024, 768),
     plotter.camera_position = "iso"
     plotter.camera.elevation = 10
     plotter.reset_camera()
-    plotter.camera.zoom(1.3)
+    extent = np.subtract(vox.bounds[1], vox.bounds[0])
+    if extent.max() <= 1.5 * np.sort(extent)[1]:  # compact: fill more of the frame
+        plotter.camera.zoom(1.3)
     plotter.screenshot(path)
     plotter.close()
     return path
