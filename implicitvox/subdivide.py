@@ -70,6 +70,13 @@ def classify(func: Function, grid: Grid, level: int, coords: np.ndarray,
     lo, hi = grid.octant_boxes(level, coords)
     flo, fhi = func.interval_columns(lo, hi)
     state = _states(flo, fhi)
+    return _tighten(func, lo, hi, flo, fhi, state, exact, mean_value)
+
+
+def _tighten(func: Function, lo, hi, flo: np.ndarray, fhi: np.ndarray, state: np.ndarray,
+             exact, mean_value: bool) -> np.ndarray:
+    """Settle the AMBIGUOUS states further: the mean value form (reusing the
+    natural bounds ``flo, fhi`` already computed), then the exact test."""
     if mean_value:
         amb = np.flatnonzero(state == AMBIGUOUS)
         if amb.size:
@@ -133,14 +140,18 @@ def classify_children(func: Function, grid: Grid, level: int, parents: np.ndarra
     lo, hi = _child_boxes(grid, level, parents)
     flo, fhi = func.interval_columns(lo, hi)
     kids = (parents[None, :, :] * 2 + _CHILD_OFFSETS[:, None, :]).reshape(-1, 3)
-    state = _states(flo.reshape(-1), fhi.reshape(-1))
+    flo, fhi = flo.reshape(-1), fhi.reshape(-1)
+    state = _states(flo, fhi)
     inside = _inside(grid, level + 1, kids)
     if inside is not None:
-        kids, state = kids[inside], state[inside]
+        kids, state, flo, fhi = kids[inside], state[inside], flo[inside], fhi[inside]
     if mean_value or exact is not None:
         amb = np.flatnonzero(state == AMBIGUOUS)
         if amb.size:
-            state[amb] = classify(func, grid, level + 1, kids[amb], exact, mean_value)
+            # the natural bounds are known: only the boxes are rebuilt, as columns
+            box_lo, box_hi = grid.octant_boxes(level + 1, kids[amb])
+            state[amb] = _tighten(func, box_lo, box_hi, flo[amb], fhi[amb], state[amb],
+                                  exact, mean_value)
     return kids, state
 
 
