@@ -22,6 +22,9 @@ from .octree import Octree, PointerOctree
 from .shape import AMBIGUOUS, EMPTY, FULL, Shape
 from .sweep import repeat, repeat_polar
 from .voxelizer import voxelize
+from .mesh_voxelizer import voxelize_mesh
+from .winding import winding_numbers
+from .bezier import BezierPatch, utah_teapot, voxelize_bezier
 from .voxels import Voxels
 from .functions import (abs, acos, asin, atan, atan2, clip, cos, exp, floor, hypot, log,
                         max, min, sin, sqrt, square, tan)
@@ -33,7 +36,8 @@ __all__ = [
     "Function", "compile",
     "r", "rho", "theta", "phi", "spherical", "cylindrical", "Spherical", "Cylindrical",
     "radius", "elevation", "repeat", "repeat_polar",
-    "voxelize", "Voxels", "Grid", "Octree", "PointerOctree", "load",
+    "voxelize", "voxelize_mesh", "winding_numbers", "BezierPatch", "voxelize_bezier",
+    "utah_teapot", "Voxels", "Grid", "Octree", "PointerOctree", "load",
     "Shape", "EMPTY", "FULL", "AMBIGUOUS",
     "abs", "acos", "asin", "atan", "atan2", "clip", "cos", "exp", "floor", "hypot", "log",
     "max", "min", "sin", "sqrt", "square", "tan",

@@ -150,7 +150,15 @@ class Voxels:
         """Continue the subdivision ``levels`` more levels (Stolte §1: "continued
         from that point"): the result equals a direct voxelization at
         ``2**levels`` times the resolution."""
+        from .bezier import BezierSource, refine_bezier_voxels
+        from .mesh_voxelizer import MeshSource, refine_mesh_voxels
         from .voxelizer import refine_voxels
+        if isinstance(self._shape, (MeshSource, BezierSource)):
+            if isinstance(levels, bool) or not isinstance(levels, (int, np.integer)) or levels < 1:
+                raise ValueError(f"levels must be a positive int, got {levels!r}")
+            if isinstance(self._shape, BezierSource):
+                return refine_bezier_voxels(self, levels, progress=progress)
+            return refine_mesh_voxels(self, levels, progress=progress)
         return refine_voxels(self, levels, progress=progress)
 
     # -- outputs ------------------------------------------------------------------------

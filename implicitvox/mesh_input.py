@@ -1,0 +1,120 @@
+"""Triangle meshes in: ``(vertices, faces)`` arrays, PyVista objects, or files.
+
+Everything is checked here, once, with errors that say what and where: a
+``(vertices, faces)`` pair gives float vertices ``(v, 3)`` and int faces
+``(f, 3)``; faces must index existing vertices; the vertices the faces use
+must be finite. Files (``.stl``, ``.ply``, ``.obj``, ``.vtk``, ``.vtp``) are
+read through PyVista; polygons are split into triangles, lines and points
+are ignored.
+
+Examples
+--------
+>>> import numpy as np
+>>> v, f = as_triangles((np.eye(3), [[0, 1, 2]]))
+>>> v.shape, f.tolist()
+((3, 3), [[0, 1, 2]])
+>>> as_triangles((np.eye(3), [[0, 1, 3]]))
+Traceback (most recent call last):
+...
+ValueError: faces[0] refers to vertex 3, but the mesh has 3 vertices (0..2)
+"""
+from __future__ import annotations
+
+import os
+from typing import Any
+
+import numpy as np
+
+__all__ = ["as_triangles", "MESH_SUFFIXES"]
+
+#: file types read through PyVista
+MESH_SUFFIXES = (".stl", ".ply", ".obj", ".vtk", ".vtp")
+
+
+def as_triangles(mesh: Any) -> tuple[np.ndarray, np.ndarray]:
+    """``(vertices (v, 3) float64, faces (f, 3) int64)`` from any accepted mesh input."""
+    if isinstance(mesh, (str, os.PathLike)):
+        return _from_pyvista(_read(os.fspath(mesh)), f"file {os.fspath(mesh)!r}")
+    if _is_pyvista(mesh):
+        return _from_pyvista(mesh, type(mesh).__name__)
+    if isinstance(mesh, (tuple, list)) and len(mesh) == 2:
+        return _check(*mesh)
+    raise TypeError("mesh must be (vertices, faces) arrays, a PyVista mesh or a path to "
+                    f"{'/'.join(MESH_SUFFIXES)}, got {type(mesh).__name__}")
+
+
+def _check(vertices: Any, faces: Any) -> tuple[np.ndarray, np.ndarray]:
+    try:
+        v = np.asarray(vertices, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise ValueError("vertices must be an (n, 3) array of numbers") from None
+    if v.ndim != 2 or v.shape[1] != 3:
+        raise ValueError(f"vertices must have shape (n, 3), got {v.shape}")
+    f = np.asarray(faces)
+    if f.size == 0:
+        f = f.reshape(0, 3)
+    if f.ndim != 2 or f.shape[1] != 3:
+        raise ValueError(f"faces must have shape (f, 3) (triangles), got {f.shape}")
+    if not (np.issubdtype(f.dtype, np.integer) or
+            (np.issubdtype(f.dtype, np.floating) and np.all(f == np.round(f)))):
+        raise ValueError(f"faces must be integer vertex indices, got dtype {f.dtype}")
+    f = f.astype(np.int64)
+    if f.size:
+        bad = np.flatnonzero(np.any((f < 0) | (f >= len(v)), axis=1))
+        if len(bad):
+            row = int(bad[0])
+            wrong = int(f[row][(f[row] < 0) | (f[row] >= len(v))][0])
+            raise ValueError(f"faces[{row}] refers to vertex {wrong}, but the mesh has "
+                             f"{len(v)} vertices (0..{len(v) - 1})")
+        used = np.zeros(len(v), dtype=bool)
+        used[f.ravel()] = True
+        bad_v = np.flatnonzero(used & ~np.all(np.isfinite(v), axis=1))
+        if len(bad_v):
+            k = int(bad_v[0])
+            raise ValueError(f"vertex {k} is {v[k].tolist()}: the vertices of faces must be "
+                             f"finite ({len(bad_v)} such vertices)")
+    return v, f
+
+
+def _is_pyvista(obj: Any) -> bool:
+    return type(obj).__module__.startswith("pyvista")
+
+
+def _read(path: str):
+    import pyvista as pv
+    if not os.path.exists(path):
+        raise FileNotFoundError(f"mesh file not found: {path!r}")
+    suffix = os.path.splitext(path)[1].lower()
+    if suffix not in MESH_SUFFIXES:
+        raise ValueError(f"cannot read {path!r}: mesh files must be one of "
+                         f"{', '.join(MESH_SUFFIXES)}")
+    if os.path.getsize(path) == 0:
+        raise ValueError(f"cannot read {path!r}: the file is empty")
+    try:
+        return pv.read(path)
+    except Exception as err:  # VTK readers raise many types
+        raise ValueError(f"cannot read {path!r} as a {suffix} mesh: {err}") from None
+
+
+def _from_pyvista(mesh, where: str) -> tuple[np.ndarray, np.ndarray]:
+    import pyvista as pv
+    if isinstance(mesh, pv.MultiBlock):
+        mesh = mesh.combine()
+    if not isinstance(mesh, pv.PolyData):
+        if not hasattr(mesh, "extract_surface"):
+            raise ValueError(f"{where}: expected a surface mesh, got {type(mesh).__name__}")
+        mesh = mesh.extract_surface()
+    if mesh.n_cells and not mesh.is_all_triangles:
+        mesh = mesh.triangulate()
+    faces = _triangle_faces(mesh)
+    return _check(np.asarray(mesh.points, dtype=np.float64), faces)
+
+
+def _triangle_faces(mesh) -> np.ndarray:
+    """Triangles of a triangulated PolyData's polygon cells (lines, points ignored)."""
+    cells = np.asarray(mesh.faces)
+    if cells.size == 0:
+        return np.zeros((0, 3), dtype=np.int64)
+    if np.all(cells[::4] == 3) and len(cells) % 4 == 0:
+        return cells.reshape(-1, 4)[:, 1:].astype(np.int64)
+    raise ValueError("the mesh has polygons that could not be split into triangles")
