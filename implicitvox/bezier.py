@@ -98,9 +98,11 @@ class BezierPatch:
         """Points ``(..., 3)`` at parameters ``u, v`` in ``[0, 1]`` (broadcast)."""
         u, v = np.broadcast_arrays(np.asarray(u, dtype=np.float64),
                                    np.asarray(v, dtype=np.float64))
-        bu = _bernstein(self.degree[0], u)
-        bv = _bernstein(self.degree[1], v)
-        return np.einsum("...i,...j,ijk->...k", bu, bv, self.control_points)
+        m, n = self.degree
+        bu = _bernstein(m, u.ravel())                                    # (N, m + 1)
+        bv = _bernstein(n, v.ravel())                                    # (N, n + 1)
+        rows = (bu @ self.control_points.reshape(m + 1, -1)).reshape(-1, n + 1, 3)
+        return np.einsum("pj,pjk->pk", bv, rows).reshape(u.shape + (3,))
 
     def sample(self, n: int, rng: Optional[np.random.Generator] = None) -> np.ndarray:
         """``n`` points at uniformly random parameters."""
@@ -200,6 +202,13 @@ class BezierSource:
     def __init__(self, patches: list[BezierPatch], flatness: float):
         self.patches = patches
         self.flatness = flatness
+
+    def normals_at(self, points: np.ndarray) -> np.ndarray:
+        """Unit normals at ``points`` of the nearest flat piece of the patches (for shading)."""
+        from .mesh_voxelizer import nearest_triangle_normals
+        span = np.ptp(np.concatenate([p.control_points.reshape(-1, 3) for p in self.patches]), 0)
+        tri, _ = bezier_triangles(self.patches, np.full(3, 1e-3 * span.max()))
+        return nearest_triangle_normals(tri, points)
 
     def __repr__(self) -> str:
         return f"<{len(self.patches)} Bezier patches>"

@@ -5,9 +5,12 @@
     implicitvox examples
     implicitvox voxelize --example sinsin34 --resolution 256 --render sinsin.png
     implicitvox voxelize model.py --resolution 512 --bounds -1 -1 -1 1 1 1 --out model.npz
+    implicitvox voxelize bunny.obj --resolution 256 --interior --render bunny.png
 
 A model file is Python that defines ``shape`` (an expression or a shape);
-errors inside it are reported with the model's own file and line.
+errors inside it are reported with the model's own file and line. A mesh
+file (``.stl``, ``.ply``, ``.obj``, ``.vtk``, ``.vtp``) is voxelized exactly
+(:func:`implicitvox.voxelize_mesh`; ``--interior`` fills closed meshes).
 """
 from __future__ import annotations
 
@@ -83,7 +86,8 @@ def _parser() -> argparse.ArgumentParser:
     sub = parser.add_subparsers(dest="command", required=True)
     sub.add_parser("examples", help="list the built-in example models")
     vox = sub.add_parser("voxelize", help="voxelize a model")
-    vox.add_argument("model", nargs="?", help="a .py file that defines `shape`")
+    vox.add_argument("model", nargs="?",
+                     help="a .py file that defines `shape`, or a mesh (.stl .ply .obj .vtk .vtp)")
     vox.add_argument("--example", help="a built-in example instead of a model file")
     vox.add_argument("--resolution", type=int, default=256, help="voxels along the longest side")
     vox.add_argument("--bounds", type=float, nargs=6, metavar=("X0", "Y0", "Z0", "X1", "Y1", "Z1"))
@@ -113,9 +117,15 @@ def _voxelize(args: argparse.Namespace) -> int:
     from .examples import example
     from .voxelizer import voxelize
 
+    from .mesh_input import MESH_SUFFIXES
+    from .mesh_voxelizer import voxelize_mesh
+
     if (args.model is None) == (args.example is None):
         raise ModelError("give a model file or --example NAME (one of them)")
-    shape = example(args.example) if args.example else load_model(args.model)
+    is_mesh = args.model is not None and args.model.lower().endswith(MESH_SUFFIXES)
+    shape = None
+    if not is_mesh:
+        shape = example(args.example) if args.example else load_model(args.model)
     _check_writable(args.out, "--out")
     _check_writable(args.render, "--render")
     bounds = None
@@ -123,9 +133,17 @@ def _voxelize(args: argparse.Namespace) -> int:
         bounds = (tuple(args.bounds[:3]), tuple(args.bounds[3:]))
     bar = None if args.quiet else ProgressBar()
     max_memory = None if args.max_memory is None else int(args.max_memory * 2**30)
-    vox = voxelize(shape, bounds, args.resolution, interior=args.interior,
-                   normals=args.normals or bool(args.render), progress=bar, max_memory=max_memory,
-                   mean_value=args.mean_value, subvoxel=args.subvoxel)
+    if is_mesh:
+        if args.normals or args.mean_value or args.subvoxel:
+            raise ModelError("--normals, --mean-value and --subvoxel apply to implicit models, "
+                             "not to meshes")
+        vox = voxelize_mesh(args.model, args.resolution, bounds, solid=args.interior,
+                            progress=bar, max_memory=max_memory)
+    else:
+        vox = voxelize(shape, bounds, args.resolution, interior=args.interior,
+                       normals=args.normals or bool(args.render), progress=bar,
+                       max_memory=max_memory, mean_value=args.mean_value,
+                       subvoxel=args.subvoxel)
     if bar:
         bar.close()
     meta = vox.metadata
@@ -152,7 +170,7 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
                 print(f"{name:<14}{description}")
             return 0
         return _voxelize(args)
-    except (ModelError, ValueError, TypeError, MemoryError) as err:
+    except (ModelError, ValueError, TypeError, MemoryError, FileNotFoundError) as err:
         print(f"implicitvox: error: {err}", file=sys.stderr)
         return 2
 

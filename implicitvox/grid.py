@@ -88,7 +88,7 @@ class Grid:
 
     @property
     def bounds(self) -> tuple[tuple[float, ...], tuple[float, ...]]:
-        hi = tuple(self.edge(a, self.shape[a]) for a in range(3))
+        hi = tuple(float(self.edge(a, self.shape[a])) for a in range(3))
         return self.origin, hi
 
     def finer(self, levels: int) -> "Grid":

@@ -20,7 +20,9 @@ ValueError: faces[0] refers to vertex 3, but the mesh has 3 vertices (0..2)
 """
 from __future__ import annotations
 
+import logging
 import os
+import warnings
 from typing import Any
 
 import numpy as np
@@ -90,10 +92,34 @@ def _read(path: str):
                          f"{', '.join(MESH_SUFFIXES)}")
     if os.path.getsize(path) == 0:
         raise ValueError(f"cannot read {path!r}: the file is empty")
+    vtk_errors = _Collect()
+    root = logging.getLogger()
+    root.addHandler(vtk_errors)      # VTK's messages come through logging: keep them
     try:
-        return pv.read(path)
-    except Exception as err:  # VTK readers raise many types
-        raise ValueError(f"cannot read {path!r} as a {suffix} mesh: {err}") from None
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            try:
+                mesh = pv.read(path)
+            except Exception as err:  # VTK readers raise many types
+                raise ValueError(f"cannot read {path!r} as a {suffix} mesh: {err}") from None
+    finally:
+        root.removeHandler(vtk_errors)
+    failed = [w for w in caught if "error while reading" in str(w.message)]
+    if failed or vtk_errors.messages:
+        why = vtk_errors.messages[0] if vtk_errors.messages else "the VTK reader failed"
+        raise ValueError(f"cannot read {path!r} as a {suffix} mesh: {why}")
+    return mesh
+
+
+class _Collect(logging.Handler):
+    """Keeps the first line of each log record (VTK's reader errors)."""
+
+    def __init__(self) -> None:
+        super().__init__(logging.WARNING)
+        self.messages: list[str] = []
+
+    def emit(self, record: logging.LogRecord) -> None:
+        self.messages.append(record.getMessage().splitlines()[0][:200])
 
 
 def _from_pyvista(mesh, where: str) -> tuple[np.ndarray, np.ndarray]:

@@ -94,20 +94,39 @@ def _children(tris: Triangles, grid: Grid, level: int, nodes: np.ndarray,
 def _leaf_codes(tris: Triangles, grid: Grid, nodes: np.ndarray, tri: np.ndarray) -> np.ndarray:
     """Morton codes of the voxels (children of ``nodes``) that some triangle meets.
 
-    A voxel needs one witness: voxels holding a triangle's bounding box or
-    one of its vertices are accepted outright, and the exact test runs only on
-    candidates whose voxel is not accepted yet.
+    A voxel needs one witness. Candidates are grouped by voxel (one sort);
+    cheap exact accepts run first (the voxel holds the triangle's bounding
+    box or a vertex; then the plane stage of the box test), and the costly
+    edge stage runs in rounds on one candidate per still-open voxel.
     """
     child, tri, lo, hi, holds = _candidates(tris, grid, grid.depth - 1, nodes, tri)
-    holds |= vertex_in_box(tris.v[tri], lo, hi)
     codes = morton.encode(child)
-    accepted = np.unique(codes[holds])
-    test = np.flatnonzero(~holds)
-    test = test[~np.isin(codes[test], accepted, assume_unique=False)]
-    if len(test):
-        meets = tris.meet_overlapping(tri[test], lo[test], hi[test])
-        accepted = np.union1d(accepted, codes[test[meets]])
-    return accepted
+    order = np.argsort(codes, kind="stable")
+    codes, tri, lo, hi, holds = codes[order], tri[order], lo[order], hi[order], holds[order]
+    new = np.empty(len(codes), dtype=bool)
+    new[:1] = True
+    np.not_equal(codes[1:], codes[:-1], out=new[1:])
+    group = np.cumsum(new) - 1
+    done = np.zeros(int(group[-1]) + 1 if len(group) else 0, dtype=bool)
+    done[group[holds]] = True
+    lo, hi = tris._grown(tri, lo, hi)
+    pending = np.flatnonzero(~done[group])
+    meets, undecided = tris.plane_stage(tri[pending], lo[pending], hi[pending])
+    done[group[pending[meets]]] = True
+    pending = pending[undecided]
+    while len(pending):
+        pending = pending[~done[group[pending]]]
+        if not len(pending):
+            break
+        g = group[pending]
+        first = np.empty(len(pending), dtype=bool)
+        first[:1] = True
+        np.not_equal(g[1:], g[:-1], out=first[1:])
+        test = pending[first]
+        met = tris.edge_stage(tri[test], lo[test], hi[test])
+        done[group[test[met]]] = True
+        pending = pending[~first]
+    return codes[new][done]
 
 
 def _first_voxel(grid: Grid, axis: int, t: np.ndarray) -> np.ndarray:
@@ -160,9 +179,10 @@ def _start_pairs(tris: Triangles, grid: Grid) -> list[tuple[int, np.ndarray, np.
     off = np.stack([k // (c[:, 1] * c[:, 2]), (k // c[:, 2]) % c[:, 1], k % c[:, 2]], axis=1)
     nodes = lo_node[pair_tri] + off
     out = []
-    for lev in np.unique(level):
+    for lev in range(grid.depth + 1):
         sel = np.flatnonzero(level[pair_tri] == lev)
-        out.append((int(lev), nodes[sel], tri[pair_tri[sel]]))
+        if len(sel):
+            out.append((lev, nodes[sel], tri[pair_tri[sel]]))
     return out
 
 
@@ -182,7 +202,7 @@ def surface_codes(tris: Triangles, grid: Grid,
         holds[test] = tris.meet_boxes(tri[test], lo[test], hi[test])
         weight = len(nodes) / total
         if level == grid.depth:
-            found.append(np.unique(morton.encode(nodes[holds])))
+            found.append(_sorted_unique(morton.encode(nodes[holds])))
             done += weight
         else:
             _push(stack, level, nodes[holds], tri[holds], weight)
@@ -201,7 +221,16 @@ def surface_codes(tris: Triangles, grid: Grid,
             progress(min(done, 1.0))
     if not found:
         return np.zeros(0, dtype=np.uint64)
-    return np.unique(np.concatenate(found))
+    return _sorted_unique(np.concatenate(found))
+
+
+def _sorted_unique(codes: np.ndarray) -> np.ndarray:
+    """``np.unique`` by sorting (numpy's hash-based unique is slower on uint64 codes)."""
+    codes.sort()
+    keep = np.empty(len(codes), dtype=bool)
+    keep[:1] = True
+    np.not_equal(codes[1:], codes[:-1], out=keep[1:])
+    return codes[keep]
 
 
 def _push(stack, level, nodes, tri, weight) -> None:

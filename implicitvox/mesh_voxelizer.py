@@ -47,8 +47,29 @@ class MeshSource:
         self.triangles = triangles
         self.name = name
 
+    def normals_at(self, points: np.ndarray) -> np.ndarray:
+        """Unit normals ``(n, 3)`` of the triangles nearest to ``points`` (for shading)."""
+        return nearest_triangle_normals(self.triangles.v, points)
+
     def __repr__(self) -> str:
         return f"<mesh {self.name}: {len(self.triangles)} triangles>"
+
+
+def nearest_triangle_normals(triangles: np.ndarray, points: np.ndarray) -> np.ndarray:
+    """Unit normals of the triangles ``(t, 3, 3)`` nearest to ``points`` (VTK's cell
+    locator); zero for degenerate triangles."""
+    import pyvista as pv
+    if not len(triangles) or not len(points):
+        return np.zeros((len(points), 3), dtype=np.float32)
+    t = len(triangles)
+    faces = np.hstack([np.full((t, 1), 3), np.arange(3 * t).reshape(t, 3)]).ravel()
+    poly = pv.PolyData(triangles.reshape(-1, 3), faces)
+    cell = poly.find_closest_cell(np.asarray(points, dtype=np.float64))
+    n = np.cross(triangles[:, 1] - triangles[:, 0], triangles[:, 2] - triangles[:, 0])
+    norm = np.linalg.norm(n, axis=1, keepdims=True)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        unit = np.where(norm > 0, n / norm, 0.0)
+    return unit[cell].astype(np.float32)
 
 
 def default_mesh_bounds(vertices: np.ndarray, faces: np.ndarray, resolution: Any
@@ -58,7 +79,9 @@ def default_mesh_bounds(vertices: np.ndarray, faces: np.ndarray, resolution: Any
     The voxel size ``h`` makes ``resolution`` voxels span the longest side
     plus ``h``; a flat mesh gets one voxel across its flat axis.
     """
-    used = vertices[np.unique(faces)]
+    mask = np.zeros(len(vertices), dtype=bool)
+    mask[faces.ravel()] = True
+    used = vertices[mask]
     lo, hi = used.min(axis=0), used.max(axis=0)
     longest = float((hi - lo).max())
     if not longest > 0:

@@ -41,6 +41,8 @@ _DET2_BOUND = 4.0 * _EPS
 _DET3_BOUND = 8.0 * _EPS
 #: below this the float products may have underflowed: go exact
 _TINY = 2.0 ** -900
+#: products below this may have lost bits to underflow
+_NORMAL = 2.0 ** -1000
 
 
 def exact_integers(*columns: np.ndarray) -> list[np.ndarray]:
@@ -105,16 +107,18 @@ def orient3d_sign(a: np.ndarray, b: np.ndarray, c: np.ndarray, d: np.ndarray) ->
         bx, by, bz = (b[:, i] - a[:, i] for i in range(3))
         cx, cy, cz = (c[:, i] - a[:, i] for i in range(3))
         dx, dy, dz = (d[:, i] - a[:, i] for i in range(3))
-        m1 = cy * dz - cz * dy
-        m2 = cz * dx - cx * dz
-        m3 = cx * dy - cy * dx
-        det = bx * m1 + by * m2 + bz * m3
-        perm = (np.abs(bx) * (np.abs(cy * dz) + np.abs(cz * dy))
-                + np.abs(by) * (np.abs(cz * dx) + np.abs(cx * dz))
-                + np.abs(bz) * (np.abs(cx * dy) + np.abs(cy * dx)))
+        products = ((cy, dz), (cz, dy), (cz, dx), (cx, dz), (cx, dy), (cy, dx))
+        p1, p2, p3, p4, p5, p6 = (u * v for u, v in products)
+        det = bx * (p1 - p2) + by * (p3 - p4) + bz * (p5 - p6)
+        perm = (np.abs(bx) * (np.abs(p1) + np.abs(p2)) + np.abs(by) * (np.abs(p3) + np.abs(p4))
+                + np.abs(bz) * (np.abs(p5) + np.abs(p6)))
         bound = _DET3_BOUND * perm
-        sure = ((np.abs(det) > bound) & (bound > _TINY) & np.isfinite(bound)) | (perm == 0) & \
-            np.isfinite(det) & _no_tiny_factor(bx, by, bz, cx, cy, cz, dx, dy, dz)
+        sure = (np.abs(det) > bound) & (bound > _TINY) & np.isfinite(bound)
+        # an underflowed minor product would be amplified by the outer factor: go exact
+        for (u, v), prod in zip(products, (p1, p2, p3, p4, p5, p6)):
+            sure &= (np.abs(prod) >= _NORMAL) | (u == 0) | (v == 0)
+        # all terms exactly zero without underflow: the sign is 0
+        sure |= (perm == 0) & _no_tiny_factor(bx, by, bz, cx, cy, cz, dx, dy, dz)
         sign = np.sign(det).astype(np.int8)
     unsure = np.flatnonzero(~sure)
     if len(unsure):

@@ -52,7 +52,10 @@ def to_pyvista(vox: Any, kind: str = "points"):
 
 def _shading(vox: Any, light: np.ndarray) -> Optional[np.ndarray]:
     normals = vox.normals
-    if normals is None and getattr(vox, "_shape", None) is not None and vox.count:
+    source = getattr(vox, "_shape", None)
+    if normals is None and source is not None and hasattr(source, "normals_at") and vox.count:
+        normals = source.normals_at(vox.centers())
+    elif normals is None and source is not None and vox.count:
         from .function import Function
         from .voxelizer import _compute_normals
         normals = _compute_normals(Function(vox._shape.expr), vox.grid, vox.coords())

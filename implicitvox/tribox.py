@@ -87,6 +87,12 @@ class Triangles:
         for i, (j, l) in enumerate(_PLANES):
             self.normal_sign[:, i] = det2_sign((v0[:, j], v0[:, l]), (v1[:, j], v1[:, l]),
                                                (v0[:, j], v0[:, l]), (v2[:, j], v2[:, l]))
+        # the axis to project along for the quick accept: a large normal component
+        # (any nonzero one is correct; -1 for degenerate triangles)
+        with np.errstate(all="ignore"):
+            n = np.abs(np.cross(v1 - v0, v2 - v0))
+        n[self.normal_sign == 0] = -1.0
+        self.axis = np.where(n.max(axis=1) >= 0, np.argmax(n, axis=1), -1).astype(np.int8)
 
     def __len__(self) -> int:
         return len(self.v)
@@ -113,26 +119,57 @@ class Triangles:
     def meet_overlapping(self, tri: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
         """:meth:`meet_boxes` for boxes already known to overlap their triangle's
         bounding box (the box-normal axes are settled)."""
-        out = np.zeros(len(tri), dtype=bool)
-        v = self.v[tri]
-        if self.dilation is not None:
-            lo = down(lo - self.dilation[tri])
-            hi = up(hi + self.dilation[tri])
-        # a vertex in the box: they meet (exact compares, no test needed)
-        inside = vertex_in_box(v, lo, hi)
-        out[inside] = True
-        alive = np.flatnonzero(~inside)
-        v, lo, hi = v[alive], lo[alive], hi[alive]
+        lo, hi = self._grown(tri, lo, hi)
+        meets, open_ = self.plane_stage(tri, lo, hi)
+        undecided = np.flatnonzero(open_)
+        meets[undecided] = self.edge_stage(tri[undecided], lo[undecided], hi[undecided])
+        return meets
+
+    def _grown(self, tri, lo, hi):
+        if self.dilation is None:
+            return lo, hi
+        return down(lo - self.dilation[tri]), up(hi + self.dilation[tri])
+
+    def plane_stage(self, tri: np.ndarray, lo: np.ndarray, hi: np.ndarray
+                    ) -> tuple[np.ndarray, np.ndarray]:
+        """First stage on bounding-box-overlapping pairs (boxes already grown by the
+        dilation): ``(meets, undecided)`` masks. Pairs in neither are disjoint.
+
+        A vertex in the box, or a box straddling the plane whose shadow lies in
+        the triangle's, meets it; a box strictly on one side of the plane does
+        not; the rest need :meth:`edge_stage`.
+        """
+        meets = vertex_in_box(self.v[tri], lo, hi)
+        alive = np.flatnonzero(~meets)
+        v, lo, hi = self.v[tri[alive]], lo[alive], hi[alive]
         sign = self.normal_sign[tri[alive]]
         keep = ~_plane_separates(v, sign, lo, hi)
+        axis = self.axis[tri[alive]]
+        for i, (j, l) in enumerate(_PLANES):
+            cand = np.flatnonzero(keep & (axis == i))
+            if len(cand):
+                sure = _shadow_inside(v[cand], sign[cand, i], lo[cand], hi[cand], j, l)
+                meets[alive[cand[sure]]] = True
+                keep[cand[sure]] = False
+        undecided = np.zeros(len(tri), dtype=bool)
+        undecided[alive[keep]] = True
+        return meets, undecided
+
+    def edge_stage(self, tri: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+        """The 9 edge-axis tests on pairs :meth:`plane_stage` left undecided."""
+        alive = np.arange(len(tri))
+        v, sign = self.v[tri], self.normal_sign[tri]
+        keep = np.ones(len(tri), dtype=bool)
         for i, (j, l) in enumerate(_PLANES):
             alive, v, lo, hi, sign = alive[keep], v[keep], lo[keep], hi[keep], sign[keep]
             if not len(alive):
-                return out
+                break
             keep = np.ones(len(alive), dtype=bool)
             for k in range(3):
                 keep &= ~_edge_separates(v, sign[:, i], lo, hi, j, l, k)
-        out[alive[keep]] = True
+        out = np.zeros(len(tri), dtype=bool)
+        if len(alive):
+            out[alive[keep]] = True
         return out
 
 
@@ -156,6 +193,29 @@ def _plane_separates(v, sign, lo, hi) -> np.ndarray:
     below = orient3d_sign(v[rest, 0], v[rest, 1], v[rest, 2], cmax) < 0
     above[rest[below]] = True
     return above
+
+
+def _shadow_inside(v, n, lo, hi, j, l) -> np.ndarray:
+    """The box's projection on the plane ``(j, l)`` lies in the (closed) projection of
+    the triangle, whose orientation there is ``sign n`` (nonzero).
+
+    With the box straddling the triangle's plane, a point of the plane in the
+    box then projects into the triangle's shadow, so it is on the triangle.
+    """
+    inside = np.ones(len(v), dtype=bool)
+    pos = n > 0
+    for k in range(3):
+        a, b = v[:, k], v[:, (k + 1) % 3]
+        aj, al, bj, bl = a[:, j], a[:, l], b[:, j], b[:, l]
+        up_l, up_j = bj - aj > 0, bl - al > 0
+        # the corner where s(q) = fj q_l - fl q_j is least (n > 0) or greatest (n < 0)
+        low_l = up_l == pos
+        low_j = up_j != pos
+        q_l = np.where(low_l, lo[:, l], hi[:, l])
+        q_j = np.where(low_j, lo[:, j], hi[:, j])
+        s = det2_sign((aj, al), (bj, bl), (aj, al), (q_j, q_l))
+        inside &= np.where(pos, s >= 0, s <= 0)
+    return inside
 
 
 def _edge_separates(v, n, lo, hi, j, l, k) -> np.ndarray:
