@@ -66,7 +66,8 @@ def main() -> None:
     tri = v[f]
     points = sample_surface(tri, 10**6, np.random.default_rng(0))
     print(f"bunny: {len(v):,} vertices, {len(f):,} triangles; 10^6 surface samples")
-    print("Varadhan et al. 2003, Table 2: bunny at 64^3, 128^3, 256^3 in 1.65, 2.01, 3.51 s (1.6 GHz Pentium IV)\n")
+    print("Varadhan et al. 2003, Table 2: bunny at 64^3, 128^3, 256^3 in 1.65, 2.01, 3.51 s "
+          "(1.6 GHz Pentium IV)\n")
     try:
         import open3d as o3d
         o3d_mesh = o3d.io.read_triangle_mesh(str(BUNNY))
