@@ -1,0 +1,174 @@
+"""Exact box classification of CSG trees with polyhedral leaves.
+
+A CSG tree is flattened to world space: transforms are pushed into the
+leaves (a :class:`~csg.primitives.Polyhedron`'s vertices are moved; any
+other subtree becomes one compiled implicit function). Each leaf classifies
+boxes as EMPTY, FULL or AMBIGUOUS:
+
+* a polyhedron exactly - AMBIGUOUS iff a triangle meets the closed box
+  (:class:`implicitvox.tribox.Triangles`), else FULL or EMPTY by the winding
+  number at the box's centre;
+* a function by its interval enclosure (sound; AMBIGUOUS may be a near miss).
+
+The booleans combine the states: a union is FULL if a child is, EMPTY if all
+are, else AMBIGUOUS; an intersection dually; a complement swaps FULL and
+EMPTY. AMBIGUOUS combined with AMBIGUOUS stays AMBIGUOUS (the surfaces may
+cancel inside the box: conservative, never a missed voxel).
+"""
+from __future__ import annotations
+
+from typing import Any, Callable, Optional
+
+import numpy as np
+
+import implicitvox as iv
+from implicitvox.shape import AMBIGUOUS, EMPTY, FULL
+from implicitvox.tribox import Triangles
+from implicitvox.crossings import RayWinding
+from implicitvox.mesh_subdivide import _sorted_unique
+
+__all__ = ["exact_classifier", "MeshClassifier"]
+
+
+def _has_mesh(solid) -> bool:
+    from .primitives import Polyhedron
+    return isinstance(solid, Polyhedron) or any(_has_mesh(c) for c in solid.children)
+
+
+def exact_classifier(solid) -> Optional[Callable[[np.ndarray, np.ndarray], np.ndarray]]:
+    """The tree's box classifier, or None when no leaf has an exact test."""
+    if not _has_mesh(solid):
+        return None
+    cache = solid.__dict__.setdefault("_classifier_cache", {})
+    if "plan" not in cache:
+        cache["plan"] = _plan(solid, np.eye(4))
+    plan = cache["plan"]
+    return lambda lo, hi: _run(plan, np.asarray(lo, dtype=float), np.asarray(hi, dtype=float))
+
+
+def _plan(solid, matrix: np.ndarray) -> tuple:
+    from .primitives import Polyhedron
+    from .solid import Complement, Difference, Intersection, Transformed, Union
+    if not _has_mesh(solid):
+        expr = Transformed(solid, matrix).expr if not np.array_equal(matrix, np.eye(4)) \
+            else solid.expr
+        return ("function", iv.compile(expr))
+    if isinstance(solid, Polyhedron):
+        v = solid.vertices @ matrix[:3, :3].T + matrix[:3, 3]
+        flip = np.linalg.det(matrix[:3, :3]) < 0      # mirrored: the winding sign flips
+        return ("mesh", MeshClassifier(v, solid.faces, flip))
+    if isinstance(solid, Transformed):
+        return _plan(solid.children[0], matrix @ solid.matrix)
+    kids = [_plan(c, matrix) for c in solid.children]
+    if isinstance(solid, Union):
+        return ("union", kids)
+    if isinstance(solid, Intersection):
+        return ("intersection", kids)
+    if isinstance(solid, Difference):
+        return ("intersection", [kids[0]] + [("complement", k) for k in kids[1:]])
+    if isinstance(solid, Complement):
+        return ("complement", kids[0])
+    raise TypeError(f"{type(solid).__name__} with a polyhedron inside has no exact test")
+
+
+def _run(plan: tuple, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+    kind = plan[0]
+    if kind == "function":
+        flo, fhi = plan[1].interval(lo, hi)
+        state = np.full(len(lo), AMBIGUOUS, dtype=np.int8)
+        state[flo > 0] = EMPTY
+        state[fhi < 0] = FULL
+        return state
+    if kind == "mesh":
+        return plan[1].classify(lo, hi)
+    if kind == "complement":
+        s = _run(plan[1], lo, hi)
+        return np.where(s == FULL, EMPTY, np.where(s == EMPTY, FULL, s)).astype(np.int8)
+    states = [_run(k, lo, hi) for k in plan[1]]
+    if kind == "union":
+        full = np.any([s == FULL for s in states], axis=0)
+        empty = np.all([s == EMPTY for s in states], axis=0)
+    else:
+        full = np.all([s == FULL for s in states], axis=0)
+        empty = np.any([s == EMPTY for s in states], axis=0)
+    out = np.full(len(lo), AMBIGUOUS, dtype=np.int8)
+    out[full] = FULL
+    out[empty] = EMPTY
+    return out
+
+
+class MeshClassifier:
+    """Exact EMPTY / FULL / AMBIGUOUS of boxes against a closed triangle mesh.
+
+    Triangles are bucketed in a uniform grid over the mesh's box, so each box
+    is tested only against the triangles near it.
+    """
+
+    def __init__(self, vertices: np.ndarray, faces: np.ndarray, flip: bool = False):
+        self.tris = Triangles(vertices[faces])
+        self.flip = flip
+        self.winding = RayWinding(self.tris)
+        self.lo = self.tris.lo.min(axis=0)
+        self.hi = self.tris.hi.max(axis=0)
+        n = len(self.tris)
+        self.cells = int(np.clip(round(2 * n ** (1 / 3)), 1, 64))
+        span = np.where(self.hi > self.lo, self.hi - self.lo, 1.0)
+        self.cell_size = span / self.cells
+        first = self._cell(self.tris.lo)
+        last = self._cell(self.tris.hi)
+        count = np.prod(last - first + 1, axis=1)
+        tri = np.repeat(np.arange(n), count)
+        k = np.arange(len(tri)) - np.repeat(np.cumsum(count) - count, count)
+        c = (last - first + 1)[tri]
+        cell = first[tri] + np.stack([k // (c[:, 1] * c[:, 2]), (k // c[:, 2]) % c[:, 1],
+                                      k % c[:, 2]], axis=1)
+        key = (cell[:, 0] * self.cells + cell[:, 1]) * self.cells + cell[:, 2]
+        order = np.argsort(key, kind="stable")
+        self.cell_tris = tri[order]
+        self.cell_start = np.searchsorted(key[order], np.arange(self.cells ** 3 + 1))
+
+    def _cell(self, p: np.ndarray) -> np.ndarray:
+        # a cell index per point, widened by one cell below so rounding cannot drop a triangle
+        c = np.floor((p - self.lo) / self.cell_size).astype(np.int64)
+        return np.clip(c, 0, self.cells - 1)
+
+    def classify(self, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+        state = np.full(len(lo), EMPTY, dtype=np.int8)
+        near = np.flatnonzero(np.all((lo <= self.hi) & (hi >= self.lo), axis=1))
+        meets = np.zeros(len(lo), dtype=bool)
+        if len(near):
+            box, tri = self._pairs(near, lo, hi)
+            if len(box):
+                ok = self.tris.meet_boxes(tri, lo[box], hi[box])
+                meets[box[ok]] = True
+        state[meets] = AMBIGUOUS
+        rest = near[~meets[near]]
+        if len(rest):
+            # off the surface: the whole box is on the side of its centre (a box corner
+            # is exact and in the box: use it, the rounded centre could leave a thin box)
+            w = self.winding(lo[rest])
+            state[rest] = np.where(w != 0, FULL, EMPTY)
+        return state
+
+    def _pairs(self, boxes: np.ndarray, lo: np.ndarray, hi: np.ndarray):
+        """(box, triangle) candidate pairs from the cells each box covers (one cell of
+        slack on each side covers the cell computation's rounding)."""
+        first = np.maximum(self._cell(lo[boxes]) - 1, 0)
+        last = np.minimum(self._cell(hi[boxes]) + 1, self.cells - 1)
+        ext = last - first + 1
+        count = np.prod(ext, axis=1)
+        b = np.repeat(np.arange(len(boxes)), count)
+        k = np.arange(len(b)) - np.repeat(np.cumsum(count) - count, count)
+        e = ext[b]
+        cell = first[b] + np.stack([k // (e[:, 1] * e[:, 2]), (k // e[:, 2]) % e[:, 1],
+                                    k % e[:, 2]], axis=1)
+        key = (cell[:, 0] * self.cells + cell[:, 1]) * self.cells + cell[:, 2]
+        n_tris = self.cell_start[key + 1] - self.cell_start[key]
+        pb = np.repeat(b, n_tris)
+        off = np.arange(len(pb)) - np.repeat(np.cumsum(n_tris) - n_tris, n_tris)
+        pt = self.cell_tris[np.repeat(self.cell_start[key], n_tris) + off]
+        # a triangle spanning several cells appears once per cell: keep one pair
+        if len(pb):
+            pair = _sorted_unique(pb.astype(np.int64) * len(self.tris) + pt)
+            pb, pt = pair // len(self.tris), pair % len(self.tris)
+        return boxes[pb], pt

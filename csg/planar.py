@@ -1,0 +1,311 @@
+"""Planar regions and their extrusions.
+
+A 2D shape is a region ``g(x, y) <= 0`` of the plane, held as a solid whose
+function ignores ``z`` (``dim = 2``), so 2D booleans and in-plane transforms
+are the 3D ones. :func:`linear_extrude` and :func:`rotate_extrude` turn it
+into a solid by substitution, which is exact:
+
+* ``linear_extrude(g, h, twist, scale)``: ``0 <= z <= h`` and
+  ``g(R(twist * z / h)^-1 (x, y) / s(z)) <= 0``, with ``s`` growing linearly
+  from 1 to ``scale`` (OpenSCAD's convention: a positive twist turns
+  clockwise going up);
+* ``rotate_extrude(g, angle)``: ``g(rho, z) <= 0`` (the region's ``x >= 0``
+  half sweeps about the z axis), cut to the wedge ``0 <= theta <= angle``.
+
+Examples
+--------
+>>> from csg import Circle, Rectangle, linear_extrude, rotate_extrude
+>>> ring = rotate_extrude(Circle(0.25).translate((1, 0)))   # a torus
+>>> ring.bounds
+((-1.25, -1.25, -0.25), (1.25, 1.25, 0.25))
+>>> post = linear_extrude(Rectangle((1, 1), center=True), height=3, twist=90)
+>>> post.bounds[1][2]
+3.0
+"""
+from __future__ import annotations
+
+import math
+from typing import Any, Optional, Sequence
+
+import numpy as np
+
+import implicitvox as iv
+from implicitvox import Expr, x, y, z
+
+from .solid import Bounds, Solid, Union
+
+__all__ = ["Circle", "Rectangle", "Polygon", "linear_extrude", "rotate_extrude",
+           "LinearExtrude", "RotateExtrude"]
+
+
+class Shape2D(Solid):
+    dim = 2
+
+
+class Circle(Shape2D):
+    """Disc of radius ``r`` about the origin."""
+
+    def __init__(self, r: float = 1.0):
+        from .primitives import _positive
+        self.r = _positive(r, "r")
+
+    @property
+    def expr(self) -> Expr:
+        return iv.hypot(x, y) - self.r
+
+    @property
+    def bounds(self) -> Bounds:
+        return (-self.r, -self.r, 0.0), (self.r, self.r, 0.0)
+
+    def __repr__(self) -> str:
+        return f"Circle(r={self.r})"
+
+
+class Rectangle(Shape2D):
+    """Rectangle of ``size``, from the origin corner or centred."""
+
+    def __init__(self, size: Sequence[float] = (1, 1), center: bool = False):
+        s = np.asarray(size, dtype=np.float64).reshape(-1)
+        if s.shape == (1,):
+            s = np.repeat(s, 2)
+        if s.shape != (2,) or not np.all(s > 0) or not np.all(np.isfinite(s)):
+            raise ValueError(f"size must be 2 positive numbers, got {size!r}")
+        self.size, self.centered = s, bool(center)
+
+    @property
+    def expr(self) -> Expr:
+        lo = -self.size / 2 if self.centered else np.zeros(2)
+        c, h = lo + self.size / 2, self.size / 2
+        return iv.max(abs(x - c[0]) - h[0], abs(y - c[1]) - h[1])
+
+    @property
+    def bounds(self) -> Bounds:
+        lo = -self.size / 2 if self.centered else np.zeros(2)
+        hi = lo + self.size
+        return (float(lo[0]), float(lo[1]), 0.0), (float(hi[0]), float(hi[1]), 0.0)
+
+    def __repr__(self) -> str:
+        return f"Rectangle(size={self.size.tolist()}, center={self.centered})"
+
+
+def _triangulate(poly: np.ndarray) -> list[tuple[int, int, int]]:
+    """Ear clipping of a simple polygon (counter-clockwise), vertex indices."""
+    idx = list(range(len(poly)))
+    out = []
+    guard = 0
+    while len(idx) > 3 and guard < 10 * len(poly) ** 2:
+        guard += 1
+        n = len(idx)
+        for k in range(n):
+            a, b, c = idx[k - 1], idx[k], idx[(k + 1) % n]
+            pa, pb, pc = poly[a], poly[b], poly[c]
+            cross = (pb[0] - pa[0]) * (pc[1] - pa[1]) - (pb[1] - pa[1]) * (pc[0] - pa[0])
+            if cross <= 0:
+                continue
+            others = [poly[i] for i in idx if i not in (a, b, c)]
+            if any(_in_triangle(p, pa, pb, pc) for p in others):
+                continue
+            out.append((a, b, c))
+            idx.pop(k)
+            break
+        else:
+            raise ValueError("polygon is not simple (self-intersecting or degenerate)")
+    if len(idx) == 3:
+        out.append(tuple(idx))
+    return out
+
+
+def _in_triangle(p, a, b, c) -> bool:
+    def side(u, v, w):
+        return (v[0] - u[0]) * (w[1] - u[1]) - (v[1] - u[1]) * (w[0] - u[0])
+    return side(a, b, p) >= 0 and side(b, c, p) >= 0 and side(c, a, p) >= 0
+
+
+class Polygon(Shape2D):
+    """A polygon from ``points`` (k, 2); ``paths`` (lists of point indices) give an outline
+    and holes, as in OpenSCAD (the first path is the outline, the others are cut out).
+
+    The region is a union of the ear-clipping triangles of each path: its
+    function is exact in sign.
+    """
+
+    def __init__(self, points: Any, paths: Optional[Sequence[Sequence[int]]] = None):
+        pts = np.asarray(points, dtype=np.float64)
+        if pts.ndim != 2 or pts.shape[1] != 2 or len(pts) < 3 or not np.all(np.isfinite(pts)):
+            raise ValueError("points must be at least 3 finite (x, y) pairs")
+        if paths is None:
+            paths = [list(range(len(pts)))]
+        self.points = pts
+        self.paths = [list(map(int, p)) for p in paths]
+        for i, p in enumerate(self.paths):
+            if len(p) < 3 or min(p) < 0 or max(p) >= len(pts):
+                raise ValueError(f"paths[{i}] must list at least 3 indices into points")
+        self._regions = [self._path_expr(p) for p in self.paths]
+
+    def _path_expr(self, path: list[int]) -> Expr:
+        poly = self.points[path]
+        area = 0.5 * np.sum(poly[:, 0] * np.roll(poly[:, 1], -1) - np.roll(poly[:, 0], -1) * poly[:, 1])
+        if area == 0:
+            raise ValueError("polygon has zero area")
+        if area < 0:
+            poly = poly[::-1]
+        pieces = []
+        for a, b, c in _triangulate(poly):
+            edges = []
+            for p, q in ((poly[a], poly[b]), (poly[b], poly[c]), (poly[c], poly[a])):
+                n = np.array([q[1] - p[1], p[0] - q[0]])
+                n /= np.linalg.norm(n)
+                edges.append(n[0] * (x - p[0]) + n[1] * (y - p[1]))
+            pieces.append(iv.max(*edges))
+        return iv.min(*pieces) if len(pieces) > 1 else pieces[0]
+
+    @property
+    def expr(self) -> Expr:
+        outline = self._regions[0]
+        if len(self._regions) == 1:
+            return outline
+        return iv.max(outline, *[-h for h in self._regions[1:]])
+
+    @property
+    def bounds(self) -> Bounds:
+        used = self.points[sorted({i for p in self.paths[:1] for i in p})]
+        lo, hi = used.min(axis=0), used.max(axis=0)
+        return (float(lo[0]), float(lo[1]), 0.0), (float(hi[0]), float(hi[1]), 0.0)
+
+    def __repr__(self) -> str:
+        return f"Polygon({len(self.points)} points, {len(self.paths)} paths)"
+
+
+def _as_2d(shape: Solid) -> Solid:
+    if not isinstance(shape, Solid) or shape.dim != 2:
+        raise ValueError(f"extrusions take a 2D shape (Circle, Rectangle, Polygon, ...), got "
+                         f"{type(shape).__name__}")
+    return shape
+
+
+class LinearExtrude(Solid):
+    """See :func:`linear_extrude`."""
+
+    def __init__(self, shape: Solid, height: float, twist: float = 0.0, scale: Any = 1.0,
+                 center: bool = False):
+        from .primitives import _positive
+        self._children = (_as_2d(shape),)
+        self.height = _positive(height, "height")
+        self.twist = float(twist)
+        s = np.broadcast_to(np.asarray(scale, dtype=np.float64), (2,)).copy()
+        if not np.all(s >= 0) or not np.all(np.isfinite(s)):
+            raise ValueError(f"scale must be >= 0 (one number or two), got {scale!r}")
+        self.scale_top = s
+        self.centered = bool(center)
+        if not math.isfinite(self.twist):
+            raise ValueError(f"twist must be finite, got {twist!r}")
+
+    @property
+    def children(self):
+        return self._children
+
+    @property
+    def _z0(self) -> float:
+        return -self.height / 2 if self.centered else 0.0
+
+    @property
+    def expr(self) -> Expr:
+        h, z0 = self.height, self._z0
+        t = (z - z0) / h                                  # 0 at the bottom, 1 at the top
+        u, v = x, y
+        if self.twist != 0:
+            a = -math.radians(self.twist) * t             # the section is turned by -twist*t
+            u, v = iv.cos(a) * x + iv.sin(a) * y, -iv.sin(a) * x + iv.cos(a) * y
+        sx, sy = (1 + (self.scale_top[0] - 1) * t), (1 + (self.scale_top[1] - 1) * t)
+        if self.scale_top[0] != 1:
+            u = u / sx
+        if self.scale_top[1] != 1:
+            v = v / sy
+        section = self._children[0].expr.remap(x=u, y=v)
+        return iv.max(section, z0 - z, z - (z0 + h))
+
+    @property
+    def bounds(self) -> Bounds:
+        b = self._children[0].bounds
+        if b is None:
+            return None
+        lo, hi = np.array(b[0][:2]), np.array(b[1][:2])
+        s = np.maximum(self.scale_top, 1.0)
+        if self.twist != 0:                      # any rotation: the disc of the farthest corner
+            r = float(np.max(np.hypot(*np.meshgrid([lo[0], hi[0]], [lo[1], hi[1]]))))
+            lo, hi = np.array([-r, -r]), np.array([r, r])
+        lo, hi = np.minimum(lo * s, lo), np.maximum(hi * s, hi)
+        z0 = self._z0
+        return (float(lo[0]), float(lo[1]), z0), (float(hi[0]), float(hi[1]), z0 + self.height)
+
+    def __repr__(self) -> str:
+        return (f"linear_extrude({self._children[0]!r}, height={self.height}, "
+                f"twist={self.twist}, scale={self.scale_top.tolist()}, center={self.centered})")
+
+
+class RotateExtrude(Solid):
+    """See :func:`rotate_extrude`."""
+
+    def __init__(self, shape: Solid, angle: float = 360.0):
+        self._children = (_as_2d(shape),)
+        self.angle = float(angle)
+        if not (0 < abs(self.angle) <= 360):
+            raise ValueError(f"angle must be in (0, 360] degrees (or negative), got {angle!r}")
+        b = shape.bounds
+        if b is not None and b[0][0] < 0 < b[1][0]:
+            raise ValueError("rotate_extrude: the 2D shape must lie on one side of the axis "
+                             "(x >= 0); it crosses x = 0")
+
+    @property
+    def children(self):
+        return self._children
+
+    @property
+    def expr(self) -> Expr:
+        shape = self._children[0]
+        b = shape.bounds
+        rho = iv.hypot(x, y)
+        radial = rho if b is None or b[1][0] > 0 else -rho     # a shape at x <= 0 sweeps too
+        solid = shape.expr.remap(x=radial, y=z)
+        if abs(self.angle) >= 360:
+            return solid
+        return iv.max(solid, self._wedge())
+
+    def _wedge(self) -> Expr:
+        a = math.radians(abs(self.angle))
+        flip = -1.0 if self.angle < 0 else 1.0
+        yy = flip * y
+        start = -yy                                            # theta >= 0: y >= 0
+        end = math.cos(a) * yy - math.sin(a) * x                # theta <= a: right of the ray
+        return iv.max(start, end) if a <= math.pi else iv.min(start, end)
+
+    @property
+    def bounds(self) -> Bounds:
+        b = self._children[0].bounds
+        if b is None:
+            return None
+        r = max(abs(b[0][0]), abs(b[1][0]))
+        return (-r, -r, b[0][1]), (r, r, b[1][1])
+
+    def __repr__(self) -> str:
+        return f"rotate_extrude({self._children[0]!r}, angle={self.angle})"
+
+
+def linear_extrude(shape: Solid, height: float, twist: float = 0.0, scale: Any = 1.0,
+                   center: bool = False) -> Solid:
+    """Extrude a 2D shape along z to ``height`` (OpenSCAD's ``linear_extrude``).
+
+    ``twist`` degrees (clockwise going up), ``scale`` of the top section (one
+    number or per axis), ``center`` puts the solid at ``-height/2 .. height/2``.
+    """
+    return LinearExtrude(shape, height, twist, scale, center)
+
+
+def rotate_extrude(shape: Solid, angle: float = 360.0) -> Solid:
+    """Sweep a 2D shape (in ``x >= 0``) about the z axis by ``angle`` degrees,
+    counter-clockwise from the +x axis (OpenSCAD's ``rotate_extrude``)."""
+    return RotateExtrude(shape, angle)
+
+
+def union2d(*shapes: Solid) -> Solid:
+    return Union(*shapes)

@@ -1,0 +1,320 @@
+"""Primitive solids with named parameters, each an implicit function negative inside.
+
+The functions are chosen for exact signs (the surface is exactly where they
+vanish) and cheap, tight intervals: Euclidean distances where they are
+simple (sphere, torus), max-norm forms for boxes and polytopes.
+
+Examples
+--------
+>>> from csg import Sphere, Box, Cylinder
+>>> Sphere(2).bounds
+((-2.0, -2.0, -2.0), (2.0, 2.0, 2.0))
+>>> Box((1, 2, 3), center=True).bounds
+((-0.5, -1.0, -1.5), (0.5, 1.0, 1.5))
+>>> Cylinder(h=2, r1=1, r2=0).bounds      # a cone, from z = 0
+((-1.0, -1.0, 0.0), (1.0, 1.0, 2.0))
+"""
+from __future__ import annotations
+
+from typing import Any, Optional, Sequence
+
+import numpy as np
+
+import implicitvox as iv
+from implicitvox import Expr, x, y, z
+
+from .solid import Bounds, Solid
+
+__all__ = ["Sphere", "Box", "Cylinder", "Torus", "Ellipsoid", "HalfSpace", "ConvexPolyhedron",
+           "Polyhedron"]
+
+
+def _positive(value: Any, name: str) -> float:
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} must be a number, got {value!r}") from None
+    if not (v > 0 and np.isfinite(v)):
+        raise ValueError(f"{name} must be positive and finite, got {value!r}")
+    return v
+
+
+def _nonneg(value: Any, name: str) -> float:
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} must be a number, got {value!r}") from None
+    if not (v >= 0 and np.isfinite(v)):
+        raise ValueError(f"{name} must be >= 0 and finite, got {value!r}")
+    return v
+
+
+def _point(value: Any, name: str) -> np.ndarray:
+    try:
+        p = np.asarray(value, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} must be 3 numbers, got {value!r}") from None
+    if p.shape == ():
+        p = np.full(3, float(p))
+    if p.shape != (3,) or not np.all(np.isfinite(p)):
+        raise ValueError(f"{name} must be 3 finite numbers, got {value!r}")
+    return p
+
+
+def _box(lo: Sequence[float], hi: Sequence[float]) -> Bounds:
+    return tuple(float(v) for v in lo), tuple(float(v) for v in hi)
+
+
+class Sphere(Solid):
+    """Ball of radius ``r`` about ``center``: ``|p - c| - r``."""
+
+    def __init__(self, r: float = 1.0, center: Sequence[float] = (0, 0, 0)):
+        self.r = _positive(r, "r")
+        self.center = _point(center, "center")
+
+    @property
+    def expr(self) -> Expr:
+        cx, cy, cz = self.center
+        return iv.sqrt((x - cx) ** 2 + (y - cy) ** 2 + (z - cz) ** 2) - self.r
+
+    @property
+    def bounds(self) -> Bounds:
+        return _box(self.center - self.r, self.center + self.r)
+
+    def __repr__(self) -> str:
+        return f"Sphere(r={self.r}, center={self.center.tolist()})"
+
+
+class Box(Solid):
+    """Axis-aligned box of ``size``, from the origin corner or centred (``center=True``);
+    ``max_a(|p_a - c_a| - h_a)``."""
+
+    def __init__(self, size: Any = (1, 1, 1), center: bool = False):
+        s = _point(size, "size")
+        if not np.all(s > 0):
+            raise ValueError(f"size must be positive on every axis, got {s.tolist()}")
+        self.size = s
+        self.centered = bool(center)
+
+    @property
+    def _lo_hi(self):
+        lo = -self.size / 2 if self.centered else np.zeros(3)
+        return lo, lo + self.size
+
+    @property
+    def expr(self) -> Expr:
+        lo, hi = self._lo_hi
+        c, h = (lo + hi) / 2, (hi - lo) / 2
+        return iv.max(abs(x - c[0]) - h[0], abs(y - c[1]) - h[1], abs(z - c[2]) - h[2])
+
+    @property
+    def bounds(self) -> Bounds:
+        return _box(*self._lo_hi)
+
+    def __repr__(self) -> str:
+        return f"Box(size={self.size.tolist()}, center={self.centered})"
+
+
+class Cylinder(Solid):
+    """Cylinder, cone or frustum along z: radius ``r1`` at the bottom, ``r2`` at the top
+    (or ``r`` for both), height ``h``, from ``z = 0`` or centred."""
+
+    def __init__(self, h: float = 1.0, r: Optional[float] = None, r1: Optional[float] = None,
+                 r2: Optional[float] = None, center: bool = False):
+        self.h = _positive(h, "h")
+        if r is not None:
+            if r1 is not None or r2 is not None:
+                raise ValueError("give r, or r1 and r2, not both")
+            r1 = r2 = r
+        r1 = 1.0 if r1 is None else r1
+        r2 = r1 if r2 is None else r2
+        self.r1, self.r2 = _nonneg(r1, "r1"), _nonneg(r2, "r2")
+        if self.r1 == 0 and self.r2 == 0:
+            raise ValueError("r1 and r2 are both 0: the cylinder has no volume")
+        self.centered = bool(center)
+
+    @property
+    def _z(self) -> tuple[float, float]:
+        return (-self.h / 2, self.h / 2) if self.centered else (0.0, self.h)
+
+    @property
+    def expr(self) -> Expr:
+        z0, z1 = self._z
+        rho = iv.hypot(x, y)
+        if self.r1 == self.r2:
+            side = rho - self.r1
+        else:
+            # rho - R(z) scaled by the slant so the side is a distance-like function
+            slope = (self.r2 - self.r1) / self.h
+            side = (rho - (self.r1 + slope * (z - z0))) / float(np.hypot(1.0, slope))
+        return iv.max(side, z0 - z, z - z1)
+
+    @property
+    def bounds(self) -> Bounds:
+        r = max(self.r1, self.r2)
+        z0, z1 = self._z
+        return _box((-r, -r, z0), (r, r, z1))
+
+    def __repr__(self) -> str:
+        return f"Cylinder(h={self.h}, r1={self.r1}, r2={self.r2}, center={self.centered})"
+
+
+class Torus(Solid):
+    """Torus about the z axis: major radius ``R``, minor radius ``r``."""
+
+    def __init__(self, R: float = 1.0, r: float = 0.25):
+        self.R, self.r = _positive(R, "R"), _positive(r, "r")
+
+    @property
+    def expr(self) -> Expr:
+        return iv.hypot(iv.hypot(x, y) - self.R, z) - self.r
+
+    @property
+    def bounds(self) -> Bounds:
+        e = self.R + self.r
+        return _box((-e, -e, -self.r), (e, e, self.r))
+
+    def __repr__(self) -> str:
+        return f"Torus(R={self.R}, r={self.r})"
+
+
+class Ellipsoid(Solid):
+    """Ellipsoid with semi-axes ``radii`` about ``center``."""
+
+    def __init__(self, radii: Sequence[float] = (1, 1, 1), center: Sequence[float] = (0, 0, 0)):
+        r = _point(radii, "radii")
+        if not np.all(r > 0):
+            raise ValueError(f"radii must be positive, got {r.tolist()}")
+        self.radii, self.center = r, _point(center, "center")
+
+    @property
+    def expr(self) -> Expr:
+        (a, b, c), (cx, cy, cz) = self.radii, self.center
+        # scaled by the smallest radius: a distance-like function near the surface
+        k = float(self.radii.min())
+        return k * (iv.sqrt(((x - cx) / a) ** 2 + ((y - cy) / b) ** 2 + ((z - cz) / c) ** 2) - 1)
+
+    @property
+    def bounds(self) -> Bounds:
+        return _box(self.center - self.radii, self.center + self.radii)
+
+    def __repr__(self) -> str:
+        return f"Ellipsoid(radii={self.radii.tolist()}, center={self.center.tolist()})"
+
+
+class HalfSpace(Solid):
+    """``{p : n . p <= offset}`` (unbounded)."""
+
+    def __init__(self, normal: Sequence[float] = (0, 0, 1), offset: float = 0.0):
+        n = _point(normal, "normal")
+        length = float(np.linalg.norm(n))
+        if length == 0:
+            raise ValueError("normal must not be zero")
+        self.normal, self.offset = n / length, float(offset) / length
+
+    @property
+    def expr(self) -> Expr:
+        n = self.normal
+        return n[0] * x + n[1] * y + n[2] * z - self.offset
+
+    @property
+    def bounds(self) -> Bounds:
+        return None
+
+    def __repr__(self) -> str:
+        return f"HalfSpace(normal={self.normal.tolist()}, offset={self.offset})"
+
+
+class ConvexPolyhedron(Solid):
+    """Intersection of half-spaces ``n_i . p <= d_i``: from ``planes=(normals, offsets)``
+    or as the convex hull of ``points``. ``max_i (n_i . p - d_i)`` (unit normals)."""
+
+    def __init__(self, planes: Optional[tuple[Any, Any]] = None, points: Any = None):
+        if (planes is None) == (points is None):
+            raise ValueError("give planes=(normals, offsets) or points, one of them")
+        if points is not None:
+            pts = np.asarray(points, dtype=np.float64)
+            if pts.ndim != 2 or pts.shape[1] != 3 or len(pts) < 4 or \
+                    not np.all(np.isfinite(pts)):
+                raise ValueError("points must be an (n, 3) array of at least 4 finite points")
+            from scipy.spatial import ConvexHull, QhullError
+            try:
+                hull = ConvexHull(pts)
+            except QhullError as err:
+                raise ValueError(f"the points span no volume (flat or degenerate): "
+                                 f"{str(err).splitlines()[0]}") from None
+            normals, offsets = hull.equations[:, :3], -hull.equations[:, 3]
+            self._points = pts[hull.vertices]
+        else:
+            normals = np.asarray(planes[0], dtype=np.float64)
+            offsets = np.asarray(planes[1], dtype=np.float64)
+            if normals.ndim != 2 or normals.shape[1] != 3 or offsets.shape != (len(normals),):
+                raise ValueError("planes must be (normals (k, 3), offsets (k,))")
+            self._points = None
+        length = np.linalg.norm(normals, axis=1)
+        if np.any(length == 0) or not np.all(np.isfinite(normals)) or \
+                not np.all(np.isfinite(offsets)):
+            raise ValueError("plane normals must be finite and non-zero, offsets finite")
+        self.normals, self.offsets = normals / length[:, None], offsets / length
+
+    @property
+    def expr(self) -> Expr:
+        terms = [n[0] * x + n[1] * y + n[2] * z - d for n, d in zip(self.normals, self.offsets)]
+        return iv.max(*terms) if len(terms) > 1 else terms[0]
+
+    @property
+    def bounds(self) -> Bounds:
+        if self._points is not None:
+            return _box(self._points.min(0), self._points.max(0))
+        from scipy.optimize import linprog
+        lo, hi = np.empty(3), np.empty(3)
+        for a in range(3):
+            for sign, out in ((1, lo), (-1, hi)):
+                c = np.zeros(3)
+                c[a] = sign
+                res = linprog(c, A_ub=self.normals, b_ub=self.offsets, bounds=[(None, None)] * 3)
+                if res.status == 3:
+                    return None               # unbounded
+                if res.status != 0:
+                    raise ValueError(f"the planes bound no volume ({res.message})")
+                out[a] = sign * res.fun
+        pad = 1e-9 * (np.abs(np.concatenate([lo, hi])).max() + 1)
+        return _box(lo - pad, hi + pad)
+
+    def __repr__(self) -> str:
+        return f"ConvexPolyhedron({len(self.normals)} planes)"
+
+
+class Polyhedron(Solid):
+    """Any closed triangle mesh (``vertices``, ``faces``, or a mesh file / PyVista mesh).
+
+    Its geometry lives in an exact box classification (:mod:`csg.classify`:
+    the exact box-triangle test of :mod:`implicitvox.tribox`, and the
+    winding number for boxes off the surface). Its expression is only a
+    bound - positive outside the bounding box, zero inside - which
+    intervals read as "ask the exact test".
+    """
+
+    def __init__(self, vertices: Any, faces: Any = None):
+        from implicitvox.mesh_input import as_triangles
+        mesh = vertices if faces is None else (vertices, faces)
+        v, f = as_triangles(mesh)
+        if not len(f):
+            raise ValueError("a Polyhedron needs at least one triangle")
+        used = np.zeros(len(v), dtype=bool)
+        used[f.ravel()] = True
+        self.vertices, self.faces = v, f
+        self._lo, self._hi = v[used].min(axis=0), v[used].max(axis=0)
+
+    @property
+    def expr(self) -> Expr:
+        c, h = (self._lo + self._hi) / 2, (self._hi - self._lo) / 2
+        outside = iv.max(abs(x - c[0]) - h[0], abs(y - c[1]) - h[1], abs(z - c[2]) - h[2])
+        return iv.max(outside, 0.0)
+
+    @property
+    def bounds(self) -> Bounds:
+        return _box(self._lo, self._hi)
+
+    def __repr__(self) -> str:
+        return f"Polyhedron({len(self.vertices)} vertices, {len(self.faces)} triangles)"

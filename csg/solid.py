@@ -1,0 +1,366 @@
+"""``Solid``: a node of a CSG tree that the implicitvox kernel can voxelize.
+
+Every solid is an implicit function, negative inside (:attr:`Solid.expr`,
+for intervals and points), with conservative :attr:`Solid.bounds`. Booleans
+are ``|`` (union), ``&`` (intersection), ``-`` (difference) and ``~``
+(complement); transforms are :meth:`Solid.translate`, :meth:`Solid.rotate`,
+:meth:`Solid.scale`, :meth:`Solid.mirror` and :meth:`Solid.transform` (any
+invertible affine 4 x 4 matrix). A transformed solid is its child's function
+at the pre-image of each point, so non-uniform scales and shears are exact.
+
+Solids with a :class:`~csg.primitives.Polyhedron` leaf also have an exact box
+classification (:attr:`Solid.classify_boxes`, see :mod:`csg.classify`), which
+the voxelizer uses on boxes the intervals leave ambiguous.
+
+Examples
+--------
+>>> from csg import Box, Cylinder
+>>> bracket = Box((4, 2, 1)) - Cylinder(r=0.4, h=3, center=True).translate((1, 1, 0))
+>>> bracket.bounds
+((0.0, 0.0, 0.0), (4.0, 2.0, 1.0))
+>>> vox = bracket.voxelize(resolution=32)
+>>> vox.resolution
+(32, 16, 8)
+"""
+from __future__ import annotations
+
+import math
+from typing import Any, Callable, Optional, Sequence
+
+import numpy as np
+
+import implicitvox as iv
+from implicitvox import Expr, x, y, z
+
+__all__ = ["Solid", "Union", "Intersection", "Difference", "Complement", "Transformed",
+           "ExprSolid", "Bounds", "rotation_matrix"]
+
+Bounds = Optional[tuple[tuple[float, float, float], tuple[float, float, float]]]
+
+
+class Solid:
+    """Base class of CSG nodes (see the module docstring)."""
+
+    #: 3 for solids; 2 for planar regions (infinite prisms along z, for extrusions)
+    dim = 3
+
+    # -- what subclasses provide -------------------------------------------------
+    @property
+    def expr(self) -> Expr:
+        """The implicit function, negative inside."""
+        raise NotImplementedError
+
+    @property
+    def bounds(self) -> Bounds:
+        """A box holding the solid, or None if unbounded."""
+        raise NotImplementedError
+
+    @property
+    def children(self) -> tuple["Solid", ...]:
+        return ()
+
+    # -- booleans ------------------------------------------------------------------
+    def __or__(self, other: "Solid") -> "Solid":
+        return Union(self, _check_solid(other, "|"))
+
+    def __and__(self, other: "Solid") -> "Solid":
+        return Intersection(self, _check_solid(other, "&"))
+
+    def __sub__(self, other: "Solid") -> "Solid":
+        return Difference(self, _check_solid(other, "-"))
+
+    def __invert__(self) -> "Solid":
+        return Complement(self)
+
+    def __bool__(self) -> bool:
+        raise TypeError("a Solid has no truth value; combine solids with |, & and -")
+
+    # -- transforms --------------------------------------------------------------------
+    def transform(self, matrix: Any) -> "Solid":
+        """Apply an invertible affine 4 x 4 matrix (last row ``0 0 0 1``)."""
+        return Transformed(self, matrix)
+
+    def translate(self, offset: Sequence[float]) -> "Solid":
+        m = np.eye(4)
+        m[:3, 3] = _vector(offset, "offset")
+        return Transformed(self, m)
+
+    def rotate(self, axis: Any, degrees: float) -> "Solid":
+        """Rotate by ``degrees`` about ``axis`` (``"x"``, ``"y"``, ``"z"`` or a vector)
+        through the origin, counter-clockwise looking down the axis."""
+        m = np.eye(4)
+        m[:3, :3] = rotation_matrix(axis, degrees)
+        return Transformed(self, m)
+
+    def scale(self, factor: Any) -> "Solid":
+        """Scale by a number or per axis (non-zero)."""
+        f = np.broadcast_to(np.asarray(factor, dtype=np.float64), (3,))
+        if not np.all(np.isfinite(f)) or np.any(f == 0):
+            raise ValueError(f"scale factor must be finite and non-zero, got {factor!r}")
+        return Transformed(self, np.diag([*f, 1.0]))
+
+    def mirror(self, normal: Sequence[float]) -> "Solid":
+        """Reflect in the plane through the origin with this normal (OpenSCAD ``mirror``)."""
+        n = _vector(normal, "normal")
+        length = float(np.linalg.norm(n))
+        if length == 0:
+            raise ValueError("mirror normal must not be zero")
+        n = n / length
+        m = np.eye(4)
+        m[:3, :3] -= 2.0 * np.outer(n, n)
+        return Transformed(self, m)
+
+    # -- voxelization --------------------------------------------------------------
+    @property
+    def classify_boxes(self) -> Optional[Callable[[np.ndarray, np.ndarray], np.ndarray]]:
+        """Exact box test (:mod:`csg.classify`) if a leaf has one, else None."""
+        from .classify import exact_classifier
+        return exact_classifier(self)
+
+    def voxelize(self, resolution: Any = 256, bounds: Any = None, **options: Any) -> iv.Voxels:
+        """:func:`implicitvox.voxelize` this solid (bounds default to its own)."""
+        if self.dim != 3:
+            raise ValueError("a 2D shape has no volume: extrude it first "
+                             "(linear_extrude or rotate_extrude)")
+        if bounds is None:
+            bounds = self.bounds
+            if bounds is None:
+                raise ValueError("the solid is unbounded (a complement or half-space): "
+                                 "pass bounds")
+            bounds = _padded(bounds)
+        return iv.voxelize(self, bounds, resolution, **options)
+
+    def to_json(self, **kwargs: Any) -> str:
+        """The solid as a JSON scene (:mod:`csg.scene`)."""
+        from .scene import to_json
+        return to_json(self, **kwargs)
+
+    def __repr__(self) -> str:
+        args = ", ".join(repr(c) for c in self.children)
+        return f"{type(self).__name__}({args})"
+
+
+def _padded(bounds) -> tuple:
+    """Bounds grown by 1% so the surface is not on the grid's edge (and flat ones have depth)."""
+    lo, hi = np.asarray(bounds[0], dtype=float), np.asarray(bounds[1], dtype=float)
+    pad = 0.01 * max(float((hi - lo).max()), 1e-300)
+    return tuple((lo - pad).tolist()), tuple((hi + pad).tolist())
+
+
+def _check_solid(other: Any, op: str) -> "Solid":
+    if not isinstance(other, Solid):
+        raise TypeError(f"cannot combine a Solid with {type(other).__name__} by {op}")
+    return other
+
+
+def _vector(v: Any, name: str) -> np.ndarray:
+    try:
+        a = np.asarray(v, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} must be 3 numbers, got {v!r}") from None
+    if a.shape == (2,):
+        a = np.append(a, 0.0)
+    if a.shape != (3,) or not np.all(np.isfinite(a)):
+        raise ValueError(f"{name} must be 3 finite numbers, got {v!r}")
+    return a
+
+
+def rotation_matrix(axis: Any, degrees: float) -> np.ndarray:
+    """3 x 3 rotation; exact for multiples of 90 degrees."""
+    if isinstance(axis, str):
+        if axis not in ("x", "y", "z"):
+            raise ValueError(f"axis must be 'x', 'y', 'z' or a vector, got {axis!r}")
+        axis = np.eye(3)["xyz".index(axis)]
+    u = _vector(axis, "axis")
+    norm = float(np.linalg.norm(u))
+    if norm == 0:
+        raise ValueError("rotation axis must not be zero")
+    u = u / norm
+    degrees = float(degrees)
+    if not math.isfinite(degrees):
+        raise ValueError(f"degrees must be finite, got {degrees}")
+    quarter = degrees / 90.0
+    if quarter == round(quarter):
+        c, s = [(1.0, 0.0), (0.0, 1.0), (-1.0, 0.0), (0.0, -1.0)][int(round(quarter)) % 4]
+    else:
+        c, s = math.cos(math.radians(degrees)), math.sin(math.radians(degrees))
+    k = np.array([[0, -u[2], u[1]], [u[2], 0, -u[0]], [-u[1], u[0], 0]])
+    return c * np.eye(3) + s * k + (1 - c) * np.outer(u, u)
+
+
+class Union(Solid):
+    """Points in any child: ``min`` of the functions."""
+
+    def __init__(self, *solids: Solid):
+        if not solids:
+            raise ValueError("a union needs at least one solid")
+        self._children = tuple(_check_solid(s, "|") for s in solids)
+        self.dim = max(s.dim for s in self._children)
+
+    @property
+    def children(self):
+        return self._children
+
+    @property
+    def expr(self) -> Expr:
+        return iv.min(*[c.expr for c in self._children]) if len(self._children) > 1 \
+            else self._children[0].expr
+
+    @property
+    def bounds(self) -> Bounds:
+        bs = [c.bounds for c in self._children]
+        if any(b is None for b in bs):
+            return None
+        return (tuple(np.min([b[0] for b in bs], axis=0).tolist()),
+                tuple(np.max([b[1] for b in bs], axis=0).tolist()))
+
+
+class Intersection(Solid):
+    """Points in every child: ``max`` of the functions."""
+
+    def __init__(self, *solids: Solid):
+        if not solids:
+            raise ValueError("an intersection needs at least one solid")
+        self._children = tuple(_check_solid(s, "&") for s in solids)
+        self.dim = max(s.dim for s in self._children)
+
+    @property
+    def children(self):
+        return self._children
+
+    @property
+    def expr(self) -> Expr:
+        return iv.max(*[c.expr for c in self._children]) if len(self._children) > 1 \
+            else self._children[0].expr
+
+    @property
+    def bounds(self) -> Bounds:
+        bs = [c.bounds for c in self._children if c.bounds is not None]
+        if not bs:
+            return None
+        lo = np.max([b[0] for b in bs], axis=0)
+        hi = np.min([b[1] for b in bs], axis=0)
+        hi = np.maximum(hi, lo)              # disjoint: an empty box
+        return tuple(lo.tolist()), tuple(hi.tolist())
+
+
+class Difference(Solid):
+    """The first solid minus the others: ``max(a, -b, ...)``."""
+
+    def __init__(self, first: Solid, *others: Solid):
+        self._children = (_check_solid(first, "-"),) + tuple(_check_solid(s, "-") for s in others)
+        self.dim = first.dim
+
+    @property
+    def children(self):
+        return self._children
+
+    @property
+    def expr(self) -> Expr:
+        if len(self._children) == 1:
+            return self._children[0].expr
+        return iv.max(self._children[0].expr, *[-c.expr for c in self._children[1:]])
+
+    @property
+    def bounds(self) -> Bounds:
+        return self._children[0].bounds
+
+
+class Complement(Solid):
+    """Everything outside the solid: ``-f`` (unbounded)."""
+
+    def __init__(self, solid: Solid):
+        self._children = (_check_solid(solid, "~"),)
+        self.dim = solid.dim
+
+    @property
+    def children(self):
+        return self._children
+
+    @property
+    def expr(self) -> Expr:
+        return -self._children[0].expr
+
+    @property
+    def bounds(self) -> Bounds:
+        return None
+
+
+class Transformed(Solid):
+    """A solid moved by an affine map ``p -> A p + t`` (its function at the pre-image)."""
+
+    def __init__(self, solid: Solid, matrix: Any):
+        m = np.array(matrix, dtype=np.float64)
+        if m.shape == (3, 3):
+            m = np.block([[m, np.zeros((3, 1))], [np.zeros((1, 3)), np.ones((1, 1))]])
+        if m.shape != (4, 4) or not np.all(np.isfinite(m)):
+            raise ValueError(f"transform must be a finite 4 x 4 (or 3 x 3) matrix, got shape "
+                             f"{m.shape}")
+        if not np.array_equal(m[3], [0, 0, 0, 1]):
+            raise ValueError(f"transform must be affine (last row 0 0 0 1), got {m[3].tolist()}")
+        det = float(np.linalg.det(m[:3, :3]))
+        if not abs(det) > 1e-300:
+            raise ValueError("transform is singular (determinant 0): a solid would collapse "
+                             "to a plane, line or point")
+        if solid.dim == 2 and not (np.allclose(m[2], [0, 0, 1, 0]) and
+                                   np.allclose(m[:2, 2], 0)):
+            raise ValueError("a 2D shape can only be moved within its plane")
+        self._children = (solid,)
+        self.matrix = m
+        self.dim = solid.dim
+
+    @property
+    def children(self):
+        return self._children
+
+    @property
+    def inverse(self) -> np.ndarray:
+        return np.linalg.inv(self.matrix)
+
+    @property
+    def expr(self) -> Expr:
+        inv = self.inverse
+        u = [inv[i, 0] * x + inv[i, 1] * y + inv[i, 2] * z + inv[i, 3] for i in range(3)]
+        return self._children[0].expr.remap(x=u[0], y=u[1], z=u[2])
+
+    @property
+    def bounds(self) -> Bounds:
+        b = self._children[0].bounds
+        if b is None:
+            return None
+        lo, hi = np.asarray(b[0], dtype=float), np.asarray(b[1], dtype=float)
+        if self.dim == 2:
+            lo[2], hi[2] = -1.0, 1.0        # placeholder depth of a planar region
+        corners = np.array([[(lo, hi)[(k >> a) & 1][a] for a in range(3)] for k in range(8)])
+        moved = corners @ self.matrix[:3, :3].T + self.matrix[:3, 3]
+        span = np.abs(moved).max() + 1.0
+        new_lo = moved.min(axis=0) - 1e-12 * span   # conservative: the products rounded
+        new_hi = moved.max(axis=0) + 1e-12 * span
+        if self.dim == 2:
+            new_lo[2], new_hi[2] = b[0][2], b[1][2]
+        return tuple(new_lo.tolist()), tuple(new_hi.tolist())
+
+    def __repr__(self) -> str:
+        return f"Transformed({self._children[0]!r}, matrix={self.matrix.tolist()})"
+
+
+class ExprSolid(Solid):
+    """A raw implicitvox expression as a solid (negative inside)."""
+
+    def __init__(self, expr: Any, bounds: Bounds = None):
+        self._expr = iv.wrap(expr)
+        if bounds is not None:
+            from implicitvox.grid import parse_bounds
+            bounds = parse_bounds(bounds)
+        self._bounds = bounds
+
+    @property
+    def expr(self) -> Expr:
+        return self._expr
+
+    @property
+    def bounds(self) -> Bounds:
+        return self._bounds
+
+    def __repr__(self) -> str:
+        return f"ExprSolid({self._expr!r:.80}, bounds={self._bounds})"
