@@ -19,6 +19,9 @@ from .primitives import (Box, ConvexPolyhedron, Cylinder, Ellipsoid, HalfSpace, 
                          Sphere, Torus)
 from .planar import Circle, Polygon, Rectangle, linear_extrude, rotate_extrude
 from .blends import Blobby, smooth_difference, smooth_intersection, smooth_union
+from .openscad import read_openscad
+from .openscad_parser import OpenSCADError
+from .scene import SceneError, load_json
 
 __all__ = [
     "Solid", "Union", "Intersection", "Difference", "Complement", "Transformed", "ExprSolid",
@@ -27,4 +30,5 @@ __all__ = [
     "Polyhedron",
     "Circle", "Rectangle", "Polygon", "linear_extrude", "rotate_extrude",
     "smooth_union", "smooth_intersection", "smooth_difference", "Blobby",
+    "read_openscad", "OpenSCADError", "load_json", "SceneError",
 ]

@@ -115,6 +115,28 @@ def _triangulate(poly: np.ndarray) -> list[tuple[int, int, int]]:
     return out
 
 
+def _convex(poly: np.ndarray) -> bool:
+    """Counter-clockwise and never turning right."""
+    d1 = np.roll(poly, -1, axis=0) - poly
+    d2 = np.roll(d1, -1, axis=0)
+    return bool(np.all(d1[:, 0] * d2[:, 1] - d1[:, 1] * d2[:, 0] >= 0))
+
+
+def _max_of_edges(poly: np.ndarray, order) -> Expr:
+    """``max`` over the edges of a convex counter-clockwise polygon of the distance outward."""
+    idx = list(order)
+    edges = []
+    for k in range(len(idx)):
+        p, q = poly[idx[k]], poly[idx[(k + 1) % len(idx)]]
+        n = np.array([q[1] - p[1], p[0] - q[0]])
+        length = np.linalg.norm(n)
+        if length == 0:
+            continue
+        n /= length
+        edges.append(n[0] * (x - p[0]) + n[1] * (y - p[1]))
+    return iv.max(*edges) if len(edges) > 1 else edges[0]
+
+
 def _in_triangle(p, a, b, c) -> bool:
     def side(u, v, w):
         return (v[0] - u[0]) * (w[1] - u[1]) - (v[1] - u[1]) * (w[0] - u[0])
@@ -149,6 +171,8 @@ class Polygon(Shape2D):
             raise ValueError("polygon has zero area")
         if area < 0:
             poly = poly[::-1]
+        if _convex(poly):                     # one piece: no inner edges to loosen intervals
+            return _max_of_edges(poly, range(len(poly)))
         pieces = []
         for a, b, c in _triangulate(poly):
             edges = []
@@ -246,9 +270,12 @@ class LinearExtrude(Solid):
 class RotateExtrude(Solid):
     """See :func:`rotate_extrude`."""
 
-    def __init__(self, shape: Solid, angle: float = 360.0):
+    def __init__(self, shape: Solid, angle: float = 360.0, sectors: Optional[int] = None):
         self._children = (_as_2d(shape),)
         self.angle = float(angle)
+        self.sectors = None if sectors is None else int(sectors)
+        if self.sectors is not None and self.sectors < 1:
+            raise ValueError(f"sectors must be >= 1, got {sectors!r}")
         if not (0 < abs(self.angle) <= 360):
             raise ValueError(f"angle must be in (0, 360] degrees (or negative), got {angle!r}")
         b = shape.bounds
@@ -264,7 +291,11 @@ class RotateExtrude(Solid):
     def expr(self) -> Expr:
         shape = self._children[0]
         b = shape.bounds
-        rho = iv.hypot(x, y)
+        if self.sectors is None:
+            rho = iv.hypot(x, y)
+        else:                                 # OpenSCAD's facets: planar trapezoid sectors
+            from .facets import polygonal_radius
+            rho = polygonal_radius(self.sectors, self.angle if abs(self.angle) < 360 else 360.0)
         radial = rho if b is None or b[1][0] > 0 else -rho     # a shape at x <= 0 sweeps too
         solid = shape.expr.remap(x=radial, y=z)
         if abs(self.angle) >= 360:

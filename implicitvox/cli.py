@@ -6,9 +6,11 @@
     implicitvox voxelize --example sinsin34 --resolution 256 --render sinsin.png
     implicitvox voxelize model.py --resolution 512 --bounds -1 -1 -1 1 1 1 --out model.npz
     implicitvox voxelize bunny.obj --resolution 256 --interior --render bunny.png
+    implicitvox voxelize bracket.csg --facets openscad --resolution 256 --out bracket.npz
 
 A model file is Python that defines ``shape`` (an expression or a shape);
-errors inside it are reported with the model's own file and line. A mesh
+errors inside it are reported with the model's own file and line. OpenSCAD
+``.csg`` files and JSON scenes are read by ``csg`` (registered as loaders). A mesh
 file (``.stl``, ``.ply``, ``.obj``, ``.vtk``, ``.vtp``) is voxelized exactly
 (:func:`implicitvox.voxelize_mesh`; ``--interior`` fills closed meshes).
 """
@@ -54,17 +56,41 @@ class ModelError(Exception):
     """A model file could not be loaded."""
 
 
-def load_model(path: str) -> Any:
+def _loaders() -> dict[str, Any]:
+    """Model loaders registered by other packages (``csg`` registers ``csg`` and ``json``)."""
+    from importlib.metadata import entry_points
+    found = {}
+    for ep in entry_points(group="implicitvox.loaders"):
+        found[ep.name] = ep
+    return {name: _LazyLoader(ep) for name, ep in found.items()}
+
+
+class _LazyLoader:
+    def __init__(self, ep: Any):
+        self.ep = ep
+
+    def __call__(self, path: str, **options: Any) -> Any:
+        return self.ep.load()(path, **options)
+
+
+def load_model(path: str, **options: Any) -> Any:
     """Run a model file and return its ``shape``.
 
     ``.py`` files run as Python (they are the user's own code); the error of
-    a failing model names the model's line.
+    a failing model names the model's line. Other suffixes go to the loaders
+    registered under the entry-point group ``implicitvox.loaders`` (``csg``
+    registers ``.csg`` and ``.json``); ``options`` are passed to them.
     """
     if not os.path.isfile(path):
         raise ModelError(f"no such model file: {path}")
     ext = os.path.splitext(path)[1].lower()
     if ext != ".py":
-        raise ModelError(f"unsupported model type {ext!r} for {path} (a .py file defining `shape`)")
+        loader = _loaders().get(ext.lstrip("."))
+        if loader is None:
+            known = ", ".join(["py"] + sorted(_loaders()))
+            raise ModelError(f"unsupported model type {ext!r} for {path} (model files: {known}; "
+                             "meshes: stl, ply, obj, vtk, vtp)")
+        return loader(path, **options)
     try:
         namespace = runpy.run_path(path, run_name="__implicitvox_model__")
     except SyntaxError as err:
@@ -92,6 +118,8 @@ def _parser() -> argparse.ArgumentParser:
     vox.add_argument("--resolution", type=int, default=256, help="voxels along the longest side")
     vox.add_argument("--bounds", type=float, nargs=6, metavar=("X0", "Y0", "Z0", "X1", "Y1", "Z1"))
     vox.add_argument("--interior", action="store_true", help="also find interior octants")
+    vox.add_argument("--facets", choices=["true", "openscad"], default="true",
+                     help=".csg models: true curves, or OpenSCAD's own facets")
     vox.add_argument("--normals", action="store_true", help="store normals")
     vox.add_argument("--mean-value", action="store_true",
                      help="tighter: mean value form on ambiguous octants (about 3x the time)")
@@ -125,7 +153,9 @@ def _voxelize(args: argparse.Namespace) -> int:
     is_mesh = args.model is not None and args.model.lower().endswith(MESH_SUFFIXES)
     shape = None
     if not is_mesh:
-        shape = example(args.example) if args.example else load_model(args.model)
+        shape = example(args.example) if args.example else \
+            load_model(args.model, **({"facets": args.facets} if not
+                                      args.model.endswith(".py") else {}))
     _check_writable(args.out, "--out")
     _check_writable(args.render, "--render")
     bounds = None
@@ -140,6 +170,8 @@ def _voxelize(args: argparse.Namespace) -> int:
         vox = voxelize_mesh(args.model, args.resolution, bounds, solid=args.interior,
                             progress=bar, max_memory=max_memory)
     else:
+        if bounds is None and getattr(shape, "bounds", None) is not None:
+            bounds = _padded(shape.bounds)
         vox = voxelize(shape, bounds, args.resolution, interior=args.interior,
                        normals=args.normals or bool(args.render), progress=bar,
                        max_memory=max_memory, mean_value=args.mean_value,
@@ -158,6 +190,13 @@ def _voxelize(args: argparse.Namespace) -> int:
         title = f"{name} {'x'.join(map(str, vox.resolution))}"
         print(f"rendered {vox.render(args.render, title=title)}")
     return 0
+
+
+def _padded(bounds: Any) -> Any:
+    """A shape's own bounds grown by 1% (its surface off the grid's edge)."""
+    lo, hi = bounds
+    pad = 0.01 * max(b - a for a, b in zip(lo, hi))
+    return tuple(a - pad for a in lo), tuple(b + pad for b in hi)
 
 
 def main(argv: Optional[Sequence[str]] = None) -> int:

@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import os
+import re
 import subprocess
 import sys
 
@@ -73,3 +74,45 @@ def test_console_entry_point_renders_an_example(tmp_path):
                           capture_output=True, text=True, env=env, timeout=300)
     assert proc.returncode == 0, proc.stderr
     assert png.stat().st_size > 10_000
+
+
+FIXTURES = os.path.join(os.path.dirname(__file__), "openscad")
+
+
+def test_openscad_and_json_models(tmp_path, capsys):
+    csg_file = os.path.join(FIXTURES, "bracket.csg")
+    for facets in ("true", "openscad"):
+        out_file = tmp_path / f"bracket-{facets}.npz"
+        code, out, err = run(["voxelize", csg_file, "--resolution", "32", "--facets", facets,
+                              "--out", str(out_file)], capsys)
+        assert code == 0, err
+        assert ivx.load(str(out_file)).count > 0
+    import csg
+    scene = tmp_path / "part.json"
+    scene.write_text((csg.Box((2, 2, 2), center=True) - csg.Sphere(1.2)).to_json())
+    code, out, err = run(["voxelize", str(scene), "--resolution", "16", "--quiet"], capsys)
+    assert code == 0 and "surface voxels" in out
+
+
+@pytest.mark.parametrize("content, suffix, match", [
+    ("cube(size = 1)", ".csg", r":1:15: expected ';'"),
+    ("hull() { cube(size = 1); }", ".csg", "module 'hull' is not supported"),
+    ('{"implicitvox_scene": 1, "root": {"type": "sphere"}}', ".json", r"root\.r"),
+    ("solid x", ".step", "unsupported model type '.step'"),
+])
+def test_bad_csg_and_json_models(tmp_path, capsys, content, suffix, match):
+    path = tmp_path / f"model{suffix}"
+    path.write_text(content)
+    code, _, err = run(["voxelize", str(path), "--resolution", "8", "--quiet"], capsys)
+    assert code == 2 and re.search(match, err), err
+
+
+def test_mesh_model(tmp_path, capsys):
+    import pyvista as pv
+    path = tmp_path / "nut.stl"
+    pv.examples.load_nut().save(str(path))
+    code, out, err = run(["voxelize", str(path), "--resolution", "32", "--interior", "--quiet"],
+                         capsys)
+    assert code == 0 and "interior voxels" in out, err
+    code, _, err = run(["voxelize", str(path), "--normals"], capsys)
+    assert code == 2 and "implicit models" in err

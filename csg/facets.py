@@ -1,0 +1,153 @@
+"""OpenSCAD's polygonization rules (2021.01), for ``facets="openscad"``.
+
+* fragments of a circle of radius ``r``: ``$fn`` if set (at least 3), else
+  ``ceil(max(min(360 / $fa, 2 pi r / $fs), 5))``; 3 below ``r = 2**-20``;
+* a circle's vertices at angles ``360 i / n``;
+* a sphere: ``(n + 1) // 2`` rings at polar angles ``180 (i + 1/2) / rings``,
+  each a circle of ``n`` vertices;
+* a cylinder: the circles of ``r1`` and ``r2`` (a point where a radius is 0)
+  with the fragments of ``max(r1, r2)``;
+* ``rotate_extrude``: ``max(fragments(max x) * |angle| / 360, 1)`` sectors
+  whose faces are planar trapezoids: the profile at the polygonal radius
+  ``rho_n = (x cos phi_k + y sin phi_k) / cos(w / 2)`` of sector ``k``
+  (width ``w``, mid-angle ``phi_k``) - an exact implicit form;
+* ``linear_extrude`` with twist or a non-uniform scale: ``slices`` layers
+  with each side quad split into two triangles along its shorter diagonal,
+  as OpenSCAD does (a mesh). Without ``slices`` in the file, a
+  non-uniform scale is extruded in one slice (OpenSCAD 2021.01 picks its own
+  count, not reproduced: give ``slices``).
+
+Examples
+--------
+>>> fragments(10, fn=0, fs=2, fa=12)
+30
+>>> fragments(1, fn=0, fs=2, fa=12)
+5
+>>> circle_points(1, 4).round(12).tolist()
+[[1.0, 0.0], [0.0, 1.0], [-1.0, 0.0], [0.0, -1.0]]
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+import implicitvox as iv
+from implicitvox import Expr, x, y
+
+__all__ = ["fragments", "circle_points", "sphere_points", "cylinder_points",
+           "polygonal_radius", "extrusion_mesh"]
+
+GRID_FINE = 0.00000095367431640625
+
+
+def fragments(r: float, fn: float = 0.0, fs: float = 2.0, fa: float = 12.0) -> int:
+    """OpenSCAD's ``get_fragments_from_r``."""
+    if r < GRID_FINE:
+        return 3
+    if fn > 0:
+        return int(fn) if fn >= 3 else 3
+    return int(math.ceil(max(min(360.0 / fa, r * 2 * math.pi / fs), 5)))
+
+
+def _cos_sin_degrees(deg: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """cos and sin of degrees, exact at multiples of 90 (as OpenSCAD's are)."""
+    deg = np.asarray(deg, dtype=np.float64)
+    rad = np.radians(deg)
+    c, s = np.cos(rad), np.sin(rad)
+    q = deg / 90.0
+    exact = q == np.round(q)
+    k = np.round(q).astype(np.int64) % 4
+    c = np.where(exact, np.array([1.0, 0.0, -1.0, 0.0])[k], c)
+    s = np.where(exact, np.array([0.0, 1.0, 0.0, -1.0])[k], s)
+    return c, s
+
+
+def circle_points(r: float, n: int) -> np.ndarray:
+    """``(n, 2)`` vertices of OpenSCAD's circle."""
+    c, s = _cos_sin_degrees(360.0 * np.arange(n) / n)
+    return np.stack([r * c, r * s], axis=1)
+
+
+def sphere_points(r: float, n: int) -> np.ndarray:
+    """Vertices of OpenSCAD's sphere with ``n`` fragments."""
+    rings = (n + 1) // 2
+    phi = 180.0 * (np.arange(rings) + 0.5) / rings
+    c, s = _cos_sin_degrees(phi)
+    pts = []
+    for ring_r, ring_z in zip(r * s, r * c):
+        circle = circle_points(ring_r, n)
+        pts.append(np.column_stack([circle, np.full(n, ring_z)]))
+    return np.concatenate(pts)
+
+
+def cylinder_points(r1: float, r2: float, z1: float, z2: float, n: int) -> np.ndarray:
+    """Vertices of OpenSCAD's cylinder (cone where a radius is 0)."""
+    pts = []
+    for r, zz in ((r1, z1), (r2, z2)):
+        if r > 0:
+            pts.append(np.column_stack([circle_points(r, n), np.full(n, zz)]))
+        else:
+            pts.append(np.array([[0.0, 0.0, zz]]))
+    return np.concatenate(pts)
+
+
+def polygonal_radius(n_sectors: int, angle: float) -> Expr:
+    """``rho_n(x, y)``: the circumradius of the ``n_sectors``-sided sweep through ``(x, y)``
+    (sectors of ``angle / n_sectors`` degrees from the +x axis).
+
+    Within sector ``k`` it is the projection on the sector's mid-direction
+    ``phi_k`` over ``cos(w / 2)``; the nearest mid-direction gives the largest
+    projection, so ``rho_n`` is the maximum over the sectors - a max of linear
+    functions, whose intervals are tight (no angle, no floor).
+    """
+    w = angle / n_sectors
+    c, s = _cos_sin_degrees(w * (np.arange(n_sectors) + 0.5))
+    scale = 1.0 / math.cos(math.radians(w / 2))
+    if n_sectors == 1 or w > 180:
+        raise ValueError(f"{n_sectors} sector(s) over {angle} degrees: each must be < 180")
+    terms = [(ci * scale) * x + (si * scale) * y for ci, si in zip(c, s)]
+    return iv.max(*terms)
+
+
+def extrusion_mesh(outline: np.ndarray, height: float, twist: float, scale: np.ndarray,
+                   slices: int, z0: float) -> tuple[np.ndarray, np.ndarray]:
+    """Vertices and triangles of OpenSCAD's linear extrusion of one polygon outline.
+
+    Layer ``i`` is the outline scaled by ``1 + (scale - 1) i / slices`` and turned by
+    ``-twist i / slices`` degrees at ``z0 + height i / slices``.
+    """
+    from .planar import _triangulate
+    poly = np.asarray(outline, dtype=np.float64)
+    area = 0.5 * np.sum(poly[:, 0] * np.roll(poly[:, 1], -1) - np.roll(poly[:, 0], -1) * poly[:, 1])
+    if area < 0:
+        poly = poly[::-1]
+    k = len(poly)
+    layers = []
+    for i in range(slices + 1):
+        t = i / slices
+        sx, sy = 1 + (scale[0] - 1) * t, 1 + (scale[1] - 1) * t
+        c, s = _cos_sin_degrees(-twist * t)
+        px, py = poly[:, 0] * sx, poly[:, 1] * sy
+        layers.append(np.column_stack([c * px - s * py, s * px + c * py,
+                                       np.full(k, z0 + height * t)]))
+    verts = np.concatenate(layers)
+    faces = []
+    for i in range(slices):
+        a, b = i * k, (i + 1) * k
+        for j in range(k):
+            j1 = (j + 1) % k
+            # OpenSCAD splits a side quad along its shorter diagonal
+            d1 = np.sum((verts[a + j] - verts[b + j1]) ** 2)
+            d2 = np.sum((verts[a + j1] - verts[b + j]) ** 2)
+            if d1 <= d2:
+                faces.append((a + j, a + j1, b + j1))
+                faces.append((a + j, b + j1, b + j))
+            else:
+                faces.append((a + j, a + j1, b + j))
+                faces.append((a + j1, b + j1, b + j))
+    cap = _triangulate(poly)
+    faces += [(c, b_, a_) for a_, b_, c in cap]                       # bottom, facing down
+    top = slices * k
+    faces += [(top + a_, top + b_, top + c) for a_, b_, c in cap]     # top, facing up
+    return verts, np.array(faces, dtype=np.int64)

@@ -1,0 +1,342 @@
+"""``read_openscad``: OpenSCAD's ``.csg`` files as :class:`~csg.solid.Solid` trees.
+
+Supported modules: ``group, union, difference, intersection, multmatrix,
+cube, sphere, cylinder, polyhedron, circle, square, polygon, linear_extrude,
+rotate_extrude, color, render`` with ``$fn, $fa, $fs``. Any other module
+(``hull``, ``minkowski``, ``offset``, ``text``, ``import``, ``resize``, ...) is
+refused with its name, line and column. Nothing is evaluated.
+
+``facets="true"`` (default) voxelizes the true curved primitives;
+``facets="openscad"`` reproduces OpenSCAD's own polygonization
+(:mod:`csg.facets`): spheres and cylinders become the convex polyhedra
+OpenSCAD builds, circles its polygons, ``rotate_extrude`` its sectors, and a
+twisted or unevenly scaled ``linear_extrude`` its sliced mesh.
+
+Examples
+--------
+>>> s = read_openscad('difference() { cube(size = [2, 2, 2], center = true); '
+...                   'sphere($fn = 0, $fa = 12, $fs = 2, r = 1.2); }')
+>>> s.bounds
+((-1.0, -1.0, -1.0), (1.0, 1.0, 1.0))
+>>> read_openscad('hull() { cube(size = 1); }')  # doctest: +ELLIPSIS
+Traceback (most recent call last):
+...
+csg.openscad_parser.OpenSCADError: <csg>:1:1: module 'hull' is not supported (supported: ...)
+"""
+from __future__ import annotations
+
+import math
+import os
+from typing import Any, Optional
+
+import numpy as np
+
+from . import facets as fx
+from .openscad_parser import Node, OpenSCADError, parse
+from .planar import Circle, LinearExtrude, Polygon, Rectangle, RotateExtrude
+from .primitives import Box, ConvexPolyhedron, Cylinder, Polyhedron, Sphere
+from .solid import Difference, Intersection, Solid, Transformed, Union
+
+__all__ = ["read_openscad", "SUPPORTED", "UNSUPPORTED"]
+
+SUPPORTED = ("group", "union", "difference", "intersection", "multmatrix", "cube", "sphere",
+             "cylinder", "polyhedron", "circle", "square", "polygon", "linear_extrude",
+             "rotate_extrude", "color", "render")
+#: OpenSCAD modules we know but do not voxelize
+UNSUPPORTED = ("hull", "minkowski", "offset", "text", "import", "resize", "surface",
+               "projection", "roof", "mirror", "rotate", "translate", "scale")
+
+
+def read_openscad(path_or_text: Any, facets: str = "true") -> Solid:
+    """Read a ``.csg`` file (path) or its text into a solid.
+
+    Parameters
+    ----------
+    path_or_text : str or os.PathLike
+        A path to a ``.csg`` file, or ``.csg`` text (anything containing ``(``).
+    facets : {"true", "openscad"}
+        Voxelize true curves, or OpenSCAD's facets.
+
+    Raises
+    ------
+    OpenSCADError
+        Malformed or unsupported input (a ``ValueError`` with line and column).
+    """
+    if facets not in ("true", "openscad"):
+        raise ValueError(f"facets must be 'true' or 'openscad', got {facets!r}")
+    if isinstance(path_or_text, os.PathLike) or (isinstance(path_or_text, str)
+                                                  and "(" not in path_or_text):
+        path = os.fspath(path_or_text)
+        if not os.path.isfile(path):
+            raise FileNotFoundError(f"no such .csg file: {path}")
+        with open(path, encoding="utf-8", errors="replace") as fh:
+            text, source = fh.read(), path
+    elif isinstance(path_or_text, str):
+        text, source = path_or_text, "<csg>"
+    else:
+        raise TypeError(f"expected a path or .csg text, got {type(path_or_text).__name__}")
+    nodes = parse(text, source)
+    builder = _Builder(source, facets == "openscad")
+    solids = [s for s in (builder.build(n) for n in nodes) if s is not None]
+    if not solids:
+        raise OpenSCADError("the file holds no geometry", 1, 1, source)
+    return solids[0] if len(solids) == 1 else Union(*solids)
+
+
+#: convex hulls with more faces become polyhedra (exact test, grid-indexed) instead of a
+#: max over planes, whose cost grows with the number of planes
+MAX_PLANES = 64
+
+
+def _convex(points: np.ndarray) -> Solid:
+    from scipy.spatial import ConvexHull
+    hull = ConvexHull(points)
+    if len(hull.equations) <= MAX_PLANES:
+        return ConvexPolyhedron(points=points)
+    faces = hull.simplices.copy()
+    # orient every triangle outward: its normal along the hull's facet normal
+    v = points[faces]
+    n = np.cross(v[:, 1] - v[:, 0], v[:, 2] - v[:, 0])
+    flip = np.einsum("ij,ij->i", n, hull.equations[:, :3]) < 0
+    faces[flip] = faces[flip][:, ::-1]
+    return Polyhedron(points, faces)
+
+
+class _Builder:
+    def __init__(self, source: str, faceted: bool):
+        self.source, self.faceted = source, faceted
+
+    def error(self, node: Node, message: str) -> OpenSCADError:
+        return OpenSCADError(message, node.line, node.column, self.source)
+
+    # -- arguments -------------------------------------------------------------------
+    def arg(self, node: Node, name: str, default: Any = None, index: Optional[int] = None):
+        if name in node.args:
+            return node.args[name]
+        if index is not None and index < len(node.positional):
+            return node.positional[index]
+        return default
+
+    def number(self, node: Node, name: str, default: Any = None, index: Optional[int] = None,
+               positive: bool = False) -> float:
+        v = self.arg(node, name, default, index)
+        if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
+            raise self.error(node, f"{node.name}: {name} must be a finite number, got {v!r}")
+        if positive and not v > 0:
+            raise self.error(node, f"{node.name}: {name} must be positive, got {v!r}")
+        return float(v)
+
+    def vector(self, node: Node, name: str, n: int, default: Any = None,
+               index: Optional[int] = None) -> np.ndarray:
+        v = self.arg(node, name, default, index)
+        if isinstance(v, (int, float)) and not isinstance(v, bool):
+            v = [v] * n
+        if not isinstance(v, list) or len(v) != n or not all(
+                isinstance(c, (int, float)) and not isinstance(c, bool) and math.isfinite(c)
+                for c in v):
+            raise self.error(node, f"{node.name}: {name} must be {n} finite numbers, got {v!r}")
+        return np.array(v, dtype=np.float64)
+
+    def flag(self, node: Node, name: str, default: bool = False) -> bool:
+        v = self.arg(node, name, default)
+        if v is None:
+            return default
+        if not isinstance(v, bool):
+            raise self.error(node, f"{node.name}: {name} must be true or false, got {v!r}")
+        return v
+
+    def resolution(self, node: Node) -> tuple[float, float, float]:
+        fn = self.number(node, "$fn", 0.0)
+        fa = self.number(node, "$fa", 12.0)
+        fs = self.number(node, "$fs", 2.0)
+        if fa <= 0 or fs <= 0:
+            raise self.error(node, f"{node.name}: $fa and $fs must be positive")
+        return fn, fs, fa
+
+    # -- nodes -----------------------------------------------------------------------------
+    def build(self, node: Node) -> Optional[Solid]:
+        handler = getattr(self, "_" + node.name, None)
+        if node.name not in SUPPORTED or handler is None:
+            known = "not supported" if node.name in UNSUPPORTED else "unknown"
+            raise self.error(node, f"module {node.name!r} is {known} (supported: "
+                                   f"{', '.join(SUPPORTED)})")
+        try:
+            return handler(node)
+        except OpenSCADError:
+            raise
+        except ValueError as err:         # a primitive refused its parameters
+            raise self.error(node, f"{node.name}: {err}") from None
+
+    def children(self, node: Node) -> list[Solid]:
+        return [s for s in (self.build(c) for c in node.children) if s is not None]
+
+    def _group(self, node: Node) -> Optional[Solid]:
+        kids = self.children(node)
+        if not kids:
+            return None
+        return kids[0] if len(kids) == 1 else Union(*kids)
+
+    _union = _render = _color = _group
+
+    def _difference(self, node: Node) -> Optional[Solid]:
+        if not node.children:
+            return None
+        first = self.build(node.children[0])
+        if first is None:
+            return None
+        rest = [s for s in (self.build(c) for c in node.children[1:]) if s is not None]
+        return Difference(first, *rest) if rest else first
+
+    def _intersection(self, node: Node) -> Optional[Solid]:
+        kids = self.children(node)
+        if not kids or len(kids) < len(node.children):
+            return None                       # an empty operand empties the intersection
+        return kids[0] if len(kids) == 1 else Intersection(*kids)
+
+    def _multmatrix(self, node: Node) -> Optional[Solid]:
+        m = self.arg(node, "m", None, 0)
+        try:
+            mat = np.array(m, dtype=np.float64)
+        except (TypeError, ValueError):
+            mat = None
+        if mat is None or mat.shape not in ((4, 4), (3, 4), (3, 3)) or \
+                not np.all(np.isfinite(mat)):
+            raise self.error(node, f"multmatrix: expected a 4 x 4 matrix, got {m!r:.80}")
+        if mat.shape == (3, 4):
+            mat = np.vstack([mat, [0, 0, 0, 1]])
+        body = self._group(node)
+        if body is None:
+            return None
+        if mat.shape == (4, 4) and body.dim == 2:
+            mat = mat.copy()
+            mat[2], mat[:2, 2] = [0, 0, 1, 0], 0        # 2D: only the in-plane part acts
+        return Transformed(body, mat)
+
+    def _cube(self, node: Node) -> Solid:
+        return Box(self.vector(node, "size", 3, 1.0, 0), center=self.flag(node, "center"))
+
+    def _sphere(self, node: Node) -> Solid:
+        r = self._radius(node, "r", "d", 1.0)
+        if not self.faceted:
+            return Sphere(r)
+        n = fx.fragments(r, *self.resolution(node))
+        return _convex(fx.sphere_points(r, n))
+
+    def _radius(self, node: Node, rname: str, dname: str, default: float) -> float:
+        if dname in node.args and node.args[dname] is not None:
+            return self.number(node, dname, positive=True) / 2
+        return self.number(node, rname, default, positive=True)
+
+    def _cylinder(self, node: Node) -> Optional[Solid]:
+        h = self.number(node, "h", 1.0, positive=True)
+        r = self.arg(node, "r", None)
+        r1 = self.number(node, "r1", r if r is not None else 1.0)
+        r2 = self.number(node, "r2", r if r is not None else 1.0)
+        if r1 < 0 or r2 < 0:
+            raise self.error(node, f"cylinder: radii must be >= 0, got r1={r1}, r2={r2}")
+        if r1 == 0 and r2 == 0:
+            return None
+        center = self.flag(node, "center")
+        if not self.faceted:
+            return Cylinder(h=h, r1=r1, r2=r2, center=center)
+        z1, z2 = (-h / 2, h / 2) if center else (0.0, h)
+        n = fx.fragments(max(r1, r2), *self.resolution(node))
+        return _convex(fx.cylinder_points(r1, r2, z1, z2, n))
+
+    def _polyhedron(self, node: Node) -> Solid:
+        pts = self.arg(node, "points", None, 0)
+        faces = self.arg(node, "faces", None, 1)
+        if faces is None:
+            faces = self.arg(node, "triangles", None)
+        try:
+            v = np.array(pts, dtype=np.float64)
+        except (TypeError, ValueError):
+            raise self.error(node, "polyhedron: points must be a list of [x, y, z]") from None
+        if v.ndim != 2 or v.shape[1] != 3 or not np.all(np.isfinite(v)):
+            raise self.error(node, "polyhedron: points must be a list of finite [x, y, z]")
+        if not isinstance(faces, list) or not faces:
+            raise self.error(node, "polyhedron: faces must be a non-empty list of index lists")
+        tris = []
+        for k, face in enumerate(faces):
+            if not isinstance(face, list) or len(face) < 3 or not all(
+                    isinstance(i, float) and i == int(i) and 0 <= i < len(v) for i in face):
+                raise self.error(node, f"polyhedron: faces[{k}] must list >= 3 indices into "
+                                       f"points (0..{len(v) - 1})")
+            idx = [int(i) for i in face]
+            # OpenSCAD lists faces clockwise seen from outside: fan them reversed
+            tris += [(idx[0], idx[j + 1], idx[j]) for j in range(1, len(idx) - 1)]
+        return Polyhedron(v, np.array(tris, dtype=np.int64))
+
+    def _circle(self, node: Node) -> Solid:
+        r = self._radius(node, "r", "d", 1.0)
+        if not self.faceted:
+            return Circle(r)
+        return Polygon(fx.circle_points(r, fx.fragments(r, *self.resolution(node))))
+
+    def _square(self, node: Node) -> Solid:
+        return Rectangle(self.vector(node, "size", 2, 1.0, 0), center=self.flag(node, "center"))
+
+    def _polygon(self, node: Node) -> Solid:
+        pts = self.arg(node, "points", None, 0)
+        paths = self.arg(node, "paths", None, 1)
+        try:
+            p = np.array(pts, dtype=np.float64)
+        except (TypeError, ValueError):
+            raise self.error(node, "polygon: points must be a list of [x, y]") from None
+        if p.ndim != 2 or p.shape[1] != 2:
+            raise self.error(node, "polygon: points must be a list of [x, y]")
+        if paths is not None and not (isinstance(paths, list) and all(
+                isinstance(q, list) and all(isinstance(i, float) and i == int(i) for i in q)
+                for q in paths)):
+            raise self.error(node, "polygon: paths must be lists of point indices")
+        return Polygon(p, None if paths is None else [[int(i) for i in q] for q in paths])
+
+    def _linear_extrude(self, node: Node) -> Optional[Solid]:
+        body = self._group(node)
+        if body is None:
+            return None
+        if body.dim != 2:
+            raise self.error(node, "linear_extrude: the children must be 2D")
+        h = self.number(node, "height", 100.0, 0, positive=True)
+        twist = self.number(node, "twist", 0.0)
+        scale = self.vector(node, "scale", 2, 1.0)
+        center = self.flag(node, "center")
+        if not self.faceted or (twist == 0 and scale[0] == scale[1]):
+            return LinearExtrude(body, h, twist, scale, center)
+        slices = int(self.number(node, "slices", 1.0))
+        outline = self._outline(node, body)
+        v, f = fx.extrusion_mesh(outline, h, twist, scale, max(slices, 1),
+                                 -h / 2 if center else 0.0)
+        return Polyhedron(v, f)
+
+    def _outline(self, node: Node, body: Solid) -> np.ndarray:
+        """The polygon of a single-outline 2D shape (for OpenSCAD's sliced extrusion)."""
+        matrix = np.eye(4)
+        while isinstance(body, Transformed):
+            matrix = matrix @ body.matrix
+            body = body.children[0]
+        if isinstance(body, Rectangle):
+            lo = -body.size / 2 if body.centered else np.zeros(2)
+            hi = lo + body.size
+            pts = np.array([[lo[0], lo[1]], [hi[0], lo[1]], [hi[0], hi[1]], [lo[0], hi[1]]])
+        elif isinstance(body, Polygon) and len(body.paths) == 1:
+            pts = body.points[body.paths[0]]
+        else:
+            raise self.error(node, "facets='openscad': a twisted or unevenly scaled "
+                                   "linear_extrude supports one square, circle or polygon "
+                                   "without holes (use facets='true')")
+        return pts @ matrix[:2, :2].T + matrix[:2, 3]
+
+    def _rotate_extrude(self, node: Node) -> Optional[Solid]:
+        body = self._group(node)
+        if body is None:
+            return None
+        if body.dim != 2:
+            raise self.error(node, "rotate_extrude: the children must be 2D")
+        angle = self.number(node, "angle", 360.0)
+        if not self.faceted:
+            return RotateExtrude(body, angle)
+        b = body.bounds
+        max_x = max(abs(b[0][0]), abs(b[1][0])) if b is not None else 1.0
+        n = max(int(fx.fragments(max_x, *self.resolution(node)) * abs(angle) / 360), 1)
+        return RotateExtrude(body, angle, sectors=n)

@@ -1,0 +1,25 @@
+"""
+A bracket and a knob from OpenSCAD
+==================================
+
+``openscad bracket.scad -o bracket.csg`` writes the evaluated CSG tree;
+:func:`csg.read_openscad` turns it into solids with true curves (or, with
+``facets="openscad"``, OpenSCAD's own facets) and the kernel voxelizes them.
+"""
+# %%
+import sys
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+from common import RESOLUTION, out  # noqa: E402
+
+from csg import read_openscad  # noqa: E402
+
+HERE = Path(__file__).resolve().parent
+
+# %%
+for name in ("bracket", "knob"):
+    solid = read_openscad(HERE / f"{name}.csg")
+    vox = solid.voxelize(RESOLUTION, interior=True)
+    print(vox.render(out(f"{name}.png"), title=f"{name}.scad, {vox.count:,} surface voxels"),
+          vox.count)

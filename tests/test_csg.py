@@ -1,0 +1,184 @@
+"""csg solids: volumes bracketed, surfaces never missed, transforms, classification, JSON."""
+from __future__ import annotations
+
+import json
+import math
+
+import numpy as np
+import pytest
+import pyvista as pv
+
+import csg
+import implicitvox as ivx
+from csg import (Blobby, Box, Circle, ConvexPolyhedron, Cylinder, Ellipsoid, HalfSpace,
+                 Polygon, Polyhedron, Rectangle, SceneError, Sphere, Torus, load_json,
+                 linear_extrude, rotate_extrude, smooth_union)
+from implicitvox.shape import AMBIGUOUS, EMPTY, FULL
+from tests.surface import found, surface_brackets
+
+SPHERE_MESH = pv.Sphere(radius=1.0, theta_resolution=24, phi_resolution=24)
+
+VOLUMES = [
+    ("sphere", Sphere(1), 4 / 3 * math.pi),
+    ("rotated box", Box((1, 2, 3)).rotate("x", 30).rotate((1, 1, 0), 17), 6.0),
+    ("cylinder", Cylinder(h=2, r=1, center=True), 2 * math.pi),
+    ("cone", Cylinder(h=2, r1=1, r2=0), 2 * math.pi / 3),
+    ("torus", Torus(1, 0.3), 2 * math.pi ** 2 * 0.09),
+    ("ellipsoid", Ellipsoid((1, 2, 0.5)), 4 / 3 * math.pi),
+    ("box - sphere", Box((2, 2, 2), center=True) - Sphere(0.5), 8 - math.pi / 6),
+    # two unit spheres 1 apart: the lens is pi (4 r + d) (2 r - d)^2 / 12 = 5 pi / 12
+    ("two spheres", Sphere(1) | Sphere(1, center=(1, 0, 0)), 8 / 3 * math.pi - 5 * math.pi / 12),
+    ("lens", Sphere(1) & Sphere(1, center=(1, 0, 0)), 5 * math.pi / 12),
+    ("scaled sphere", Sphere(1).scale((2, 1, 0.5)), 4 / 3 * math.pi),
+    ("mirrored cone", Cylinder(h=2, r1=1, r2=0).mirror((0, 0, 1)), 2 * math.pi / 3),
+    ("revolved disc", rotate_extrude(Circle(0.3).translate((1, 0))), 2 * math.pi ** 2 * 0.09),
+    ("270 degrees", rotate_extrude(Circle(0.3).translate((1, 0)), 270),
+     1.5 * math.pi ** 2 * 0.09),
+    ("twisted prism", linear_extrude(Rectangle((1, 1), center=True), 2, twist=120), 2.0),
+    ("frustum prism", linear_extrude(Rectangle((1, 1), center=True), 2, scale=0.5), 7 / 6),
+    ("concave prism", linear_extrude(Polygon([(0, 0), (2, 0), (2, 2), (1, 0.5), (0, 2)]), 1),
+     2.5),
+    ("holed prism", linear_extrude(Polygon([(0, 0), (3, 0), (3, 3), (0, 3), (1, 1), (2, 1),
+                                            (2, 2), (1, 2)], [[0, 1, 2, 3], [4, 5, 6, 7]]), 1),
+     8.0),
+    ("octahedron", ConvexPolyhedron(points=[(1, 0, 0), (-1, 0, 0), (0, 1, 0), (0, -1, 0),
+                                            (0, 0, 1), (0, 0, -1)]), 4 / 3),
+    ("polyhedron", Polyhedron(SPHERE_MESH), SPHERE_MESH.volume),
+    ("polyhedron - cylinder", Polyhedron(SPHERE_MESH).scale((1, 1, 2))
+     - Cylinder(h=5, r=0.4, center=True), None),
+]
+
+
+@pytest.mark.parametrize("name, solid, volume", VOLUMES, ids=[v[0] for v in VOLUMES])
+def test_interior_and_surface_bracket_the_volume(name, solid, volume):
+    vox = solid.voxelize(48, interior=True)
+    cell = float(np.prod(vox.voxel_size))
+    inner = vox.interior_count * cell
+    outer = (vox.interior_count + vox.count) * cell
+    if volume is None:       # polyhedron minus a cylinder: Monte Carlo with exact winding
+        from implicitvox.crossings import RayWinding
+        from implicitvox.mesh_input import as_triangles
+        v, f = as_triangles(SPHERE_MESH.scale((1, 1, 2), inplace=False))
+        rng = np.random.default_rng(0)
+        (lo, hi), n = solid.bounds, 400_000
+        p = rng.uniform(lo, hi, (n, 3))
+        hit = (RayWinding(v[f])(p) != 0) & (np.hypot(p[:, 0], p[:, 1]) > 0.4)
+        box = float(np.prod(np.subtract(hi, lo)))
+        volume, sigma = hit.mean() * box, box * math.sqrt(hit.mean() * (1 - hit.mean()) / n)
+        assert inner <= volume + 4 * sigma and volume - 4 * sigma <= outer
+        return
+    assert inner <= volume <= outer
+    assert outer - inner < 0.6 * volume        # and the bracket is not vacuous
+
+
+NEVER_MISS = [
+    Box((1, 2, 3)).rotate("x", 30),
+    Cylinder(h=2, r1=1, r2=0.3).rotate("y", 45),
+    Torus(1, 0.25).rotate((1, 1, 1), 33),
+    (Box((2, 2, 1), center=True) | Sphere(0.8).translate((0, 0, 0.5))) - Cylinder(r=0.3, h=4,
+                                                                                   center=True),
+    linear_extrude(Rectangle((1, 1), center=True), 2, twist=90, scale=0.5),
+    rotate_extrude(Polygon([(0.5, 0), (1, 0), (0.8, 0.6)]), 200),
+    smooth_union(Sphere(0.6), Sphere(0.6, center=(0.8, 0, 0)), 0.3),
+    Blobby([(0, 0, 0), (0.8, 0, 0), (0.4, 0.6, 0)], radius=0.5),
+]
+
+
+@pytest.mark.parametrize("k", range(len(NEVER_MISS)))
+def test_never_misses_a_surface_point(k):
+    solid = NEVER_MISS[k]
+    vox = solid.voxelize(64)
+    func = ivx.compile(solid.expr)
+    a, b = surface_brackets(func, vox.bounds, min(vox.voxel_size), 20_000,
+                            np.random.default_rng(k))
+    assert len(a) >= 5_000
+    assert found(vox.contains, vox.grid, a, b).all()
+
+
+def test_polyhedron_classification_is_exact():
+    """Boxes against a mesh: AMBIGUOUS iff a triangle meets them (checked by the kernel's
+    mesh voxelizer on the same grid), FULL/EMPTY agree with the winding number."""
+    solid = Polyhedron(SPHERE_MESH)
+    vox = solid.voxelize(32, bounds=((-1.2,) * 3, (1.2,) * 3), interior=True)
+    mesh_vox = ivx.voxelize_mesh(SPHERE_MESH, 32, bounds=((-1.2,) * 3, (1.2,) * 3), solid=True)
+    assert np.array_equal(vox.coords(), mesh_vox.coords())
+    assert np.array_equal(vox.to_dense(), mesh_vox.to_dense())
+    classify = solid.classify_boxes
+    lo = np.array([[-0.1, -0.1, -0.1], [2, 2, 2], [0.9, -0.1, -0.1]])
+    assert classify(lo, lo + 0.2).tolist() == [FULL, EMPTY, AMBIGUOUS]
+
+
+def test_plain_solids_have_no_exact_test():
+    assert Sphere(1).classify_boxes is None
+    assert (Sphere(1) - Polyhedron(SPHERE_MESH)).classify_boxes is not None
+
+
+def test_transforms_compose_and_invert():
+    s = Box((1, 2, 3)).translate((1, 2, 3)).rotate("z", 90).scale(2).mirror((1, 0, 0))
+    f = ivx.compile(s.expr)
+    # the box's corner (1, 2, 3) goes to: rotate z 90 -> (-2, 1, 3); scale 2 -> (-4, 2, 6);
+    # mirror x -> (4, 2, 6); the opposite corner (2, 4, 6) -> (8, 4, 12)
+    centre = np.array([[6.0, 3.0, 9.0]])
+    assert f(*centre.T)[0] < 0
+    assert s.bounds[0] == pytest.approx((4, 2, 6)) and s.bounds[1] == pytest.approx((8, 4, 12))
+
+
+@pytest.mark.parametrize("make, match", [
+    (lambda: Sphere(-1), "r must be positive"),
+    (lambda: Box((1, 0, 1)), "size must be positive"),
+    (lambda: Cylinder(h=1, r=1, r1=2), "give r, or r1 and r2"),
+    (lambda: Sphere(1).scale(0), "non-zero"),
+    (lambda: Sphere(1).transform(np.zeros((4, 4))), "affine"),
+    (lambda: Sphere(1).rotate("w", 10), "axis must be"),
+    (lambda: HalfSpace((0, 0, 0)), "normal must not be zero"),
+    (lambda: ConvexPolyhedron(points=[(0, 0, 0), (1, 0, 0), (0, 1, 0), (1, 1, 0)]), "no volume"),
+    (lambda: Polygon([(0, 0), (1, 1), (2, 2)]), "zero area"),
+    (lambda: rotate_extrude(Circle(1)), "one side of the axis"),
+    (lambda: linear_extrude(Sphere(1), 1), "2D shape"),
+    (lambda: Sphere(1) | 3, "cannot combine"),
+])
+def test_bad_solids(make, match):
+    with pytest.raises((ValueError, TypeError), match=match):
+        make()
+
+
+def test_truth_value_refused():
+    with pytest.raises(TypeError, match="no truth value"):
+        bool(Sphere(1))
+
+
+def test_json_round_trip_exact():
+    s = (Box((2, 2, 2), center=True) - Sphere(1.2).translate((0, 0, 1))) | \
+        linear_extrude(Polygon([(0, 0), (2, 0), (1, 1)]), 1, twist=30, scale=(0.5, 1))
+    s = s | csg.ExprSolid(ivx.sqrt(ivx.x ** 2 + ivx.y ** 2) - 0.1 * ivx.sin(ivx.z))
+    text = s.to_json()
+    again = load_json(text)
+    assert again.to_json() == text and again.expr.equals(s.expr)
+
+
+HOSTILE = [
+    ('{"implicitvox_scene": 1, "root": ' + '{"type": "complement", "child": ' * 300
+     + '{"type": "sphere", "r": 1}' + "}" * 301, "nested deeper"),
+    ('[' * 100000 + ']' * 100000, "nested too deeply|a scene is"),
+    ('{"implicitvox_scene": 1, "root": {"type": "polyhedron", "vertices": [' +
+     ",".join(["[0,0,0]"] * 2_000_000) + '], "faces": [[0,1,2]]}}', "more than"),
+    ('{"implicitvox_scene": 1, "root": {"type": "sphere", "r": true}}', r"root\.r"),
+    ('{"implicitvox_scene": 1, "root": {"type": "box", "size": [1, 2]}}', r"root\.size"),
+    ('{"implicitvox_scene": 1, "root": {"type": "union", "children": [{"type": "sphere", '
+     '"r": 1}, {"type": "teapot"}]}}', r"root\.children\[1\]\.type"),
+    ('{"implicitvox_scene": 1, "root": {"type": "sphere", "r": NaN}}', "NaN"),
+    ('{"implicitvox_scene": 1, "root": {"type": "expression", "expr": '
+     '"__import__(\'os\').system(\'echo hi\')"}}', "not allowed"),
+    ('{"implicitvox_scene": 1, "root": {"type": "expression", "expr": "x.real"}}',
+     "not allowed"),
+    ('{"implicitvox_scene": 1, "root": {"type": "expression", "expr": "' + "(" * 5000 + "x"
+     + ")" * 5000 + '"}}', "nested too deeply|syntax error"),
+    ('{"implicitvox_scene": 2, "root": {}}', "a scene is"),
+    ('{"implicitvox_scene": 1, "root": ', "not JSON"),
+]
+
+
+@pytest.mark.parametrize("scene, match", HOSTILE, ids=[f"hostile-{i}" for i in range(len(HOSTILE))])
+def test_hostile_scenes(scene, match):
+    with pytest.raises(SceneError, match=match):
+        load_json(scene)

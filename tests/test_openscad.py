@@ -1,0 +1,195 @@
+"""OpenSCAD .csg files: facets as OpenSCAD makes them, true curves, and bad input.
+
+The fixtures under ``tests/openscad/`` are ``.scad`` models with the ``.csg`` and
+``.stl`` files OpenSCAD 2021.01 exported from them (``regenerate.sh``).
+"""
+from __future__ import annotations
+
+import math
+import re
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import implicitvox as ivx
+from csg import read_openscad
+from csg.facets import fragments
+from csg.openscad import SUPPORTED
+from csg.openscad_parser import OpenSCADError, parse
+from implicitvox.mesh_input import as_triangles
+from tests.clip_oracle import triangle_meets_box
+from tests.mesh_helpers import sample_surface
+
+FIXTURES = Path(__file__).parent / "openscad"
+MODELS = sorted(p.stem for p in FIXTURES.glob("*.csg"))
+RES = 128
+
+
+def _walk(nodes):
+    for n in nodes:
+        yield n
+        yield from _walk(n.children)
+
+
+def test_fixtures_use_every_supported_module():
+    used = set()
+    for m in MODELS:
+        used |= {n.name for n in _walk(parse((FIXTURES / f"{m}.csg").read_text()))}
+    assert set(SUPPORTED) <= used | {"union"} and "union" in used
+    assert len(MODELS) >= 6
+
+
+def _stl_voxels(model):
+    return ivx.voxelize_mesh(str(FIXTURES / f"{model}.stl"), RES)
+
+
+@pytest.mark.parametrize("model", MODELS)
+def test_facets_contain_openscads_own_voxels(model):
+    """The .csg with OpenSCAD's facets holds every voxel of the exact voxelization of
+    OpenSCAD's .stl, and at most 2% more. The .stl is written with 6 significant
+    digits: a voxel the .stl only grazes within that rounding may be absent."""
+    stl = _stl_voxels(model)
+    solid = read_openscad(FIXTURES / f"{model}.csg", facets="openscad")
+    vox = solid.voxelize(stl.resolution, bounds=stl.bounds)
+    assert vox.grid == stl.grid
+    missing = stl.coords()[~vox.contains(stl.coords())]
+    if len(missing):
+        v, f = as_triangles(str(FIXTURES / f"{model}.stl"))
+        tri = v[f]
+        tol = 2e-6 * float(np.abs(v).max())
+        g = stl.grid
+        for c in missing:
+            lo = np.array([g.edge(a, c[a]) for a in range(3)]) + tol
+            hi = np.array([g.edge(a, c[a] + 1) for a in range(3)]) - tol
+            near = np.flatnonzero(np.all((tri.min(1) <= hi) & (tri.max(1) >= lo), axis=1))
+            assert not any(triangle_meets_box(tri[t], lo, hi) for t in near), c
+    assert len(missing) <= 5
+    assert vox.count <= 1.02 * stl.count
+
+
+def _facet_tolerance(model) -> float:
+    """The largest chordal deviation of the model's curves (sagitta r (1 - cos(pi / n))),
+    times the largest scale of the transforms above them."""
+    worst = 0.0
+
+    def visit(node, scale):
+        nonlocal worst
+        a = node.args
+        if node.name == "multmatrix":
+            m = a.get("m", node.positional[0] if node.positional else None)
+            scale = scale * float(np.linalg.norm(np.array(m)[:3, :3], 2))
+        res = (a.get("$fn", 0.0), a.get("$fs", 2.0), a.get("$fa", 12.0))
+        r = None
+        if node.name in ("sphere", "circle"):
+            r = a.get("r", 1.0)
+        elif node.name == "cylinder":
+            r = max(a.get("r1", 1.0), a.get("r2", 1.0))
+        elif node.name == "rotate_extrude":
+            r = 40.0           # the profile's reach (bounded by the model's size)
+        elif node.name == "linear_extrude" and a.get("twist", 0.0) != 0:
+            # slices: a point's arc becomes a chord, and each side quad (an edge of length
+            # L turned by alpha) becomes two triangles, off the ruled surface by L alpha / 4
+            alpha = math.radians(abs(a["twist"]) / a.get("slices", 1.0))
+            length, radius = _outline_size(node.children[0])
+            k = max(1.0, *np.atleast_1d(a.get("scale", 1.0)))
+            worst = max(worst, scale * k * (length * alpha / 4 + radius * (1 - math.cos(alpha / 2))))
+        if r is not None:
+            n = fragments(r, *res)
+            worst = max(worst, scale * r * (1 - math.cos(math.pi / n)))
+        for c in node.children:
+            visit(c, scale)
+
+    for n in parse((FIXTURES / f"{model}.csg").read_text()):
+        visit(n, 1.0)
+    return worst
+
+
+def _outline_size(node) -> tuple[float, float]:
+    """Longest edge and farthest point of a 2D leaf (square, circle or polygon)."""
+    a = node.args
+    if node.name == "square":
+        size = np.broadcast_to(np.asarray(a.get("size", 1.0), dtype=float), (2,))
+        return float(size.max()), float(np.hypot(*size))
+    if node.name == "circle":
+        r = a.get("r", 1.0)
+        n = fragments(r, a.get("$fn", 0.0), a.get("$fs", 2.0), a.get("$fa", 12.0))
+        return 2 * r * math.sin(math.pi / n), r
+    pts = np.asarray(a["points"], dtype=float)
+    edges = np.linalg.norm(np.roll(pts, -1, 0) - pts, axis=1)
+    return float(edges.max()), float(np.linalg.norm(pts, axis=1).max())
+
+
+@pytest.mark.parametrize("model", MODELS)
+def test_true_curves_within_facet_tolerance(model):
+    """Every sampled point of OpenSCAD's faceted surface lies within the facets'
+    chordal tolerance of a voxel of the true-curve voxelization."""
+    stl = _stl_voxels(model)
+    solid = read_openscad(FIXTURES / f"{model}.csg")
+    vox = solid.voxelize(stl.resolution, bounds=stl.bounds)
+    v, f = as_triangles(str(FIXTURES / f"{model}.stl"))
+    pts = sample_surface(v[f], 100_000, np.random.default_rng(0))
+    idx = vox.grid.voxels_holding(pts)[0]
+    away = np.flatnonzero(~vox.contains(idx))
+    tol = _facet_tolerance(model) + 2e-6 * float(np.abs(v).max())
+    h = np.asarray(vox.voxel_size)
+    for k in away:                       # distance to the nearest output voxel around it
+        offsets = np.stack(np.meshgrid(*[np.arange(-2, 3)] * 3, indexing="ij"), -1).reshape(-1, 3)
+        cand = idx[k] + offsets
+        cand = cand[np.all((cand >= 0) & (cand < np.asarray(vox.resolution)), axis=1)]
+        cand = cand[vox.contains(cand)]
+        lo = np.stack([vox.grid.edge(a, cand[:, a]) for a in range(3)], 1)
+        d = np.linalg.norm(np.maximum(np.maximum(lo - pts[k], pts[k] - (lo + h)), 0), axis=1)
+        assert len(d) and d.min() <= tol, (model, pts[k], d.min() if len(d) else None, tol)
+
+
+BAD = [
+    ("cube(size = [1, 2, 3])", "expected ';' or '{'", (1, 23)),
+    ("frobnicate(r = 1);", "module 'frobnicate' is unknown", (1, 1)),
+    ("cube(size = [1, 2, 3x]);", "expected ',' or ']'", (1, 21)),
+    ("cube(size = 1.2.3);", "expected ',' or ')'", (1, 16)),
+    ("difference() {\n  cube(size = 1);\n", "never closed", (3, 1)),
+    ("cube(size = 1); }", "unbalanced '}'", (1, 17)),
+    ("union() { sphere(r = 1); cyl", "expected '('", (1, 29)),
+    ("sphere(r = \"big\");", "r must be a finite number", (1, 1)),
+    ("cube(size = [1, 2]);", "size must be 3 finite numbers", (1, 1)),
+    ("cube(size = 1, size = 2);", "given twice", (1, 16)),
+    ("cube(size = 1) # ;", "unexpected character", (1, 16)),
+    ("multmatrix(m = [[1, 0], [0, 1]]) cube(size = 1);", "4 x 4", (1, 1)),
+]
+
+
+@pytest.mark.parametrize("text, message, where", BAD)
+def test_malformed_csg(text, message, where):
+    with pytest.raises(OpenSCADError, match=re.escape(message)) as err:
+        read_openscad(text)
+    assert (err.value.line, err.value.column) == where
+
+
+@pytest.mark.parametrize("module", ["hull", "minkowski", "offset", "text", "import", "resize"])
+def test_unsupported_modules_are_named(module):
+    text = f"group() {{\n  {module}() {{ cube(size = 1); }}\n}}"
+    with pytest.raises(OpenSCADError, match=f"module '{module}' is not supported") as err:
+        read_openscad(text)
+    assert (err.value.line, err.value.column) == (2, 3)
+
+
+def test_hostile_nesting_and_size_fail_fast():
+    deep = "group() {" * 5000 + "cube(size = 1);" + "}" * 5000
+    with pytest.raises(OpenSCADError, match="nesting deeper"):
+        read_openscad(deep)
+    vec = "cube(size = " + "[" * 5000 + "1" + "]" * 5000 + ");"
+    with pytest.raises(OpenSCADError, match="nesting deeper"):
+        read_openscad(vec)
+    with pytest.raises(OpenSCADError, match="holds no geometry"):
+        read_openscad("group();")
+
+
+def test_truncated_file(tmp_path):
+    text = (FIXTURES / "knob.csg").read_text()
+    path = tmp_path / "cut.csg"
+    path.write_text(text[: len(text) // 2])
+    with pytest.raises(OpenSCADError, match=str(path)):
+        read_openscad(path)
+    with pytest.raises(FileNotFoundError):
+        read_openscad(tmp_path / "missing.csg")
