@@ -15,7 +15,8 @@
   with each side quad split into two triangles along its shorter diagonal,
   as OpenSCAD does (a mesh). Without ``slices`` in the file, a
   non-uniform scale is extruded in one slice (OpenSCAD 2021.01 picks its own
-  count, not reproduced: give ``slices``).
+  count, not reproduced: give ``slices``). A 2D boolean under such an extrusion
+  is extruded piece by piece (see ``_extrude_tree`` in :mod:`csg.openscad`).
 
 Examples
 --------
@@ -114,8 +115,8 @@ def extrusion_mesh(outline: np.ndarray, height: float, twist: float, scale: np.n
                    slices: int, z0: float) -> tuple[np.ndarray, np.ndarray]:
     """Vertices and triangles of OpenSCAD's linear extrusion of one polygon outline.
 
-    Layer ``i`` is the outline scaled by ``1 + (scale - 1) i / slices`` and turned by
-    ``-twist i / slices`` degrees at ``z0 + height i / slices``.
+    Layer ``i`` is the outline turned by ``-twist i / slices`` degrees, then scaled by
+    ``1 + (scale - 1) i / slices``, at ``z0 + height i / slices``.
     """
     from .planar import _triangulate
     poly = np.asarray(outline, dtype=np.float64)
@@ -128,9 +129,9 @@ def extrusion_mesh(outline: np.ndarray, height: float, twist: float, scale: np.n
         t = i / slices
         sx, sy = 1 + (scale[0] - 1) * t, 1 + (scale[1] - 1) * t
         c, s = _cos_sin_degrees(-twist * t)
-        px, py = poly[:, 0] * sx, poly[:, 1] * sy
-        layers.append(np.column_stack([c * px - s * py, s * px + c * py,
-                                       np.full(k, z0 + height * t)]))
+        # OpenSCAD turns the section, then scales it: v = S R p
+        rx, ry = c * poly[:, 0] - s * poly[:, 1], s * poly[:, 0] + c * poly[:, 1]
+        layers.append(np.column_stack([rx * sx, ry * sy, np.full(k, z0 + height * t)]))
     verts = np.concatenate(layers)
     faces = []
     for i in range(slices):

@@ -303,29 +303,38 @@ class _Builder:
         center = self.flag(node, "center")
         if not self.faceted or (twist == 0 and scale[0] == scale[1]):
             return LinearExtrude(body, h, twist, scale, center)
-        slices = int(self.number(node, "slices", 1.0))
-        outline = self._outline(node, body)
-        v, f = fx.extrusion_mesh(outline, h, twist, scale, max(slices, 1),
-                                 -h / 2 if center else 0.0)
-        return Polyhedron(v, f)
+        slices = max(int(self.number(node, "slices", 1.0)), 1)
+        return self._extrude_tree(node, body, np.eye(4), (h, twist, scale, slices,
+                                                         -h / 2 if center else 0.0))
 
-    def _outline(self, node: Node, body: Solid) -> np.ndarray:
-        """The polygon of a single-outline 2D shape (for OpenSCAD's sliced extrusion)."""
-        matrix = np.eye(4)
-        while isinstance(body, Transformed):
-            matrix = matrix @ body.matrix
-            body = body.children[0]
+    def _extrude_tree(self, node: Node, body: Solid, matrix: np.ndarray, params) -> Solid:
+        """OpenSCAD's sliced extrusion of a 2D CSG tree: each leaf outline is extruded as
+        a mesh and the meshes are combined by the same booleans (holes become
+        differences). On every slice this is exactly OpenSCAD's section; between slices,
+        where two outlines cross, OpenSCAD's walls run through the crossing point and
+        ours through each outline's own edges - they differ by second-order amounts
+        there (a few voxels along the crossing)."""
+        if isinstance(body, Transformed):
+            return self._extrude_tree(node, body.children[0], matrix @ body.matrix, params)
+        if isinstance(body, (Union, Intersection, Difference)):
+            kids = [self._extrude_tree(node, c, matrix, params) for c in body.children]
+            return type(body)(*kids)
         if isinstance(body, Rectangle):
             lo = -body.size / 2 if body.centered else np.zeros(2)
             hi = lo + body.size
-            pts = np.array([[lo[0], lo[1]], [hi[0], lo[1]], [hi[0], hi[1]], [lo[0], hi[1]]])
-        elif isinstance(body, Polygon) and len(body.paths) == 1:
-            pts = body.points[body.paths[0]]
+            outlines = [np.array([[lo[0], lo[1]], [hi[0], lo[1]], [hi[0], hi[1]],
+                                  [lo[0], hi[1]]])]
+        elif isinstance(body, Polygon):
+            outlines = [body.points[p] for p in body.paths]
         else:
-            raise self.error(node, "facets='openscad': a twisted or unevenly scaled "
-                                   "linear_extrude supports one square, circle or polygon "
-                                   "without holes (use facets='true')")
-        return pts @ matrix[:2, :2].T + matrix[:2, 3]
+            raise self.error(node, f"facets='openscad': cannot extrude a {type(body).__name__} "
+                                   "with twist or an uneven scale (use facets='true')")
+        meshes = []
+        for pts in outlines:
+            moved = pts @ matrix[:2, :2].T + matrix[:2, 3]
+            v, f = fx.extrusion_mesh(moved, *params)
+            meshes.append(Polyhedron(v, f))
+        return meshes[0] if len(meshes) == 1 else Difference(meshes[0], *meshes[1:])
 
     def _rotate_extrude(self, node: Node) -> Optional[Solid]:
         body = self._group(node)

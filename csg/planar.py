@@ -236,15 +236,17 @@ class LinearExtrude(Solid):
     def expr(self) -> Expr:
         h, z0 = self.height, self._z0
         t = (z - z0) / h                                  # 0 at the bottom, 1 at the top
+        # a section point p sits at S(t) R(t) p (turned by -twist t, then scaled, as in
+        # OpenSCAD): undo the scale, then the turn
         u, v = x, y
-        if self.twist != 0:
-            a = -math.radians(self.twist) * t             # the section is turned by -twist*t
-            u, v = iv.cos(a) * x + iv.sin(a) * y, -iv.sin(a) * x + iv.cos(a) * y
         sx, sy = (1 + (self.scale_top[0] - 1) * t), (1 + (self.scale_top[1] - 1) * t)
         if self.scale_top[0] != 1:
             u = u / sx
         if self.scale_top[1] != 1:
             v = v / sy
+        if self.twist != 0:
+            a = -math.radians(self.twist) * t
+            u, v = iv.cos(a) * u + iv.sin(a) * v, -iv.sin(a) * u + iv.cos(a) * v
         section = self._children[0].expr.remap(x=u, y=v)
         return iv.max(section, z0 - z, z - (z0 + h))
 
