@@ -106,7 +106,10 @@ def _facet_tolerance(model) -> float:
 
 
 def _outline_size(node) -> tuple[float, float]:
-    """Longest edge and farthest point of a 2D leaf (square, circle or polygon)."""
+    """Longest edge and farthest point of a 2D tree's leaves (square, circle, polygon)."""
+    if node.children:
+        sizes = [_outline_size(c) for c in node.children]
+        return max(s[0] for s in sizes), max(s[1] for s in sizes)
     a = node.args
     if node.name == "square":
         size = np.broadcast_to(np.asarray(a.get("size", 1.0), dtype=float), (2,))
@@ -133,8 +136,10 @@ def test_true_curves_within_facet_tolerance(model):
     away = np.flatnonzero(~vox.contains(idx))
     tol = _facet_tolerance(model) + 2e-6 * float(np.abs(v).max())
     h = np.asarray(vox.voxel_size)
+    reach = int(np.ceil(tol / h.min())) + 1
+    offsets = np.stack(np.meshgrid(*[np.arange(-reach, reach + 1)] * 3, indexing="ij"),
+                       -1).reshape(-1, 3)
     for k in away:                       # distance to the nearest output voxel around it
-        offsets = np.stack(np.meshgrid(*[np.arange(-2, 3)] * 3, indexing="ij"), -1).reshape(-1, 3)
         cand = idx[k] + offsets
         cand = cand[np.all((cand >= 0) & (cand < np.asarray(vox.resolution)), axis=1)]
         cand = cand[vox.contains(cand)]
