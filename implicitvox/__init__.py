@@ -25,6 +25,8 @@ from .voxelizer import voxelize
 from .mesh_voxelizer import voxelize_mesh
 from .winding import winding_numbers
 from .bezier import BezierPatch, utah_teapot, voxelize_bezier
+from . import linf
+from .linf import linf_distance
 from .voxels import Voxels
 from .functions import (abs, acos, asin, atan, atan2, clip, cos, exp, floor, hypot, log,
                         max, min, sin, sqrt, square, tan)
@@ -37,7 +39,7 @@ __all__ = [
     "r", "rho", "theta", "phi", "spherical", "cylindrical", "Spherical", "Cylindrical",
     "radius", "elevation", "repeat", "repeat_polar",
     "voxelize", "voxelize_mesh", "winding_numbers", "BezierPatch", "voxelize_bezier",
-    "utah_teapot", "Voxels", "Grid", "Octree", "PointerOctree", "load",
+    "utah_teapot", "linf", "linf_distance", "Voxels", "Grid", "Octree", "PointerOctree", "load",
     "Shape", "EMPTY", "FULL", "AMBIGUOUS",
     "abs", "acos", "asin", "atan", "atan2", "clip", "cos", "exp", "floor", "hypot", "log",
     "max", "min", "sin", "sqrt", "square", "tan",

@@ -1,0 +1,54 @@
+"""Max-norm (l-infinity) distances and exact voxel tests (Varadhan et al. §3-§5.1).
+
+Each primitive gives the signed weighted max-norm distance of points (negative
+inside; ``weights`` per axis, or per point, for non-cubic voxels) and
+``classify_boxes(lo, hi)``: EMPTY / FULL / AMBIGUOUS, where AMBIGUOUS means
+the surface meets the closed box - exactly, up to rounding at ties
+(:mod:`implicitvox.linf.classify`).
+
+* :class:`HalfSpace`, :class:`ConvexPolytope` (boxes, oriented boxes, any
+  bounded intersection of half-spaces or convex hull) - §3.1.1, §3.1.2;
+* :class:`Sphere` - §3.2 (contact equations);
+* :func:`triangle_distance` and :class:`TriangleMesh` (culling by upper and
+  lower bounds) - §3.3, §4.1.
+
+Not yet here: ellipsoids and general quadrics, capped cylinders and cones,
+the torus.
+
+Examples
+--------
+>>> import numpy as np
+>>> from implicitvox import linf
+>>> linf_distance(linf.Sphere((0, 0, 0), 1.0), np.array([[2.0, 0.0, 0.0]])).tolist()
+[1.0]
+"""
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from .classify import classify_by_distance
+from .mesh import TriangleMesh
+from .polytope import ConvexPolytope, HalfSpace, triangle_distance
+from .sphere import Sphere
+
+__all__ = ["linf_distance", "HalfSpace", "ConvexPolytope", "Sphere", "TriangleMesh",
+           "triangle_distance", "classify_by_distance"]
+
+
+def linf_distance(shape: Any, points: Any, weights: Any = None) -> np.ndarray:
+    """Signed weighted max-norm distance from ``points (n, 3)`` to ``shape``.
+
+    ``shape`` is a primitive of this module or any object with a
+    ``linf_distance(points, weights)`` method (as :mod:`csg` solids with
+    exact leaves have).
+    """
+    if hasattr(shape, "distance") and isinstance(shape, (HalfSpace, ConvexPolytope, Sphere,
+                                                         TriangleMesh)):
+        return shape.distance(points, weights)
+    method = getattr(shape, "linf_distance", None)
+    if callable(method):
+        return method(points, weights)
+    raise TypeError(f"no max-norm distance for {type(shape).__name__}: use a primitive of "
+                    "implicitvox.linf (HalfSpace, ConvexPolytope, Sphere, TriangleMesh)")

@@ -1,0 +1,176 @@
+"""Max-norm distance to convex polytopes, half-spaces and triangles (Varadhan §3.1.1-§3.1.2, §3.3.1).
+
+The weighted max-norm ball around ``p`` is the box ``B(p, t) = p + t [-w, w]``.
+For a point outside a convex polytope ``P`` the distance is the smallest
+``t`` at which ``B(p, t)`` touches ``P``. Below it the two convex sets are
+disjoint, so one axis of the separating axis theorem separates them: a box
+normal, a face normal of ``P``, or a box axis crossed with an edge of ``P``.
+Along an axis ``u`` they are apart while ``u.p + t h_w(u) < min_P u.x``, so
+
+    D(p) = max over candidate axes u (both signs) of (min_P u.x - u.p) / h_w(u),
+
+a maximum of finitely many closed forms (any other direction gives a lower
+value, so extra candidates are harmless). Inside ``P`` the box first leaves
+``P`` through a face plane: ``D(p) = -min_f (d_f - n_f.p) / h_w(n_f)``.
+A triangle is a flat polytope (unsigned: its distance is ``max(0, ...)``).
+
+Examples
+--------
+>>> import numpy as np
+>>> cube = ConvexPolytope.from_points(np.array([[x, y, z] for x in (0, 1) for y in (0, 1)
+...                                              for z in (0, 1)], dtype=float))
+>>> cube.distance(np.array([[2.0, 0.5, 0.5], [0.5, 0.5, 0.5], [3.0, 4.0, -1.0]])).tolist()
+[1.0, -0.5, 3.0]
+"""
+from __future__ import annotations
+
+from typing import Any, Optional
+
+import numpy as np
+
+from .norm import as_points, as_weights
+
+__all__ = ["ConvexPolytope", "HalfSpace", "triangle_distance", "CHUNK"]
+
+#: points per block (memory: points x axes)
+CHUNK = 1 << 14
+
+
+def _unique_directions(u: np.ndarray) -> np.ndarray:
+    """Unit directions without zeros and without (anti)parallel duplicates."""
+    n = np.linalg.norm(u, axis=1)
+    u = u[n > 1e-12 * max(float(n.max()) if len(n) else 1.0, 1e-300)]
+    u = u / np.linalg.norm(u, axis=1, keepdims=True)
+    # one sign per direction (the other is added later), then drop duplicates
+    first = np.argmax(np.abs(u) > 1e-12, axis=1)
+    u = u * np.sign(u[np.arange(len(u)), first])[:, None]
+    key = np.round(u, 12)
+    _, keep = np.unique(key, axis=0, return_index=True)
+    return u[np.sort(keep)]
+
+
+class ConvexPolytope:
+    """A bounded convex polytope: ``n_f . x <= d_f`` with its vertices and edges.
+
+    Use :meth:`from_points` (convex hull) or :meth:`from_planes`.
+    """
+
+    def __init__(self, normals: np.ndarray, offsets: np.ndarray, vertices: np.ndarray,
+                 edges: np.ndarray):
+        length = np.linalg.norm(normals, axis=1)
+        self.normals = normals / length[:, None]
+        self.offsets = offsets / length
+        self.vertices = np.asarray(vertices, dtype=np.float64)
+        box = np.eye(3)
+        cross = np.cross(box[:, None, :], np.asarray(edges, dtype=np.float64)[None]).reshape(-1, 3)
+        u = _unique_directions(np.concatenate([box, self.normals, cross]))
+        self.axes = np.concatenate([u, -u])                    # (A, 3)
+        proj = self.vertices @ self.axes.T                      # (m, A)
+        self.low = proj.min(axis=0)                             # min_P u.x per axis
+
+    @classmethod
+    def from_points(cls, points: Any) -> "ConvexPolytope":
+        """The convex hull of ``points`` (n, 3), which must span a volume."""
+        from scipy.spatial import ConvexHull, QhullError
+        pts = as_points(points)
+        try:
+            hull = ConvexHull(pts)
+        except QhullError as err:
+            raise ValueError(f"the points span no volume: {str(err).splitlines()[0]}") from None
+        simp = hull.simplices
+        edges = np.concatenate([pts[simp[:, (k + 1) % 3]] - pts[simp[:, k]] for k in range(3)])
+        return cls(hull.equations[:, :3], -hull.equations[:, 3], pts[hull.vertices], edges)
+
+    @classmethod
+    def from_planes(cls, normals: Any, offsets: Any) -> "ConvexPolytope":
+        """The intersection of half-spaces ``normals . x <= offsets`` (bounded)."""
+        from scipy.optimize import linprog
+        from scipy.spatial import HalfspaceIntersection
+        n = np.asarray(normals, dtype=np.float64)
+        d = np.asarray(offsets, dtype=np.float64)
+        # an interior point: the centre of the largest inscribed ball (a linear programme)
+        norm = np.linalg.norm(n, axis=1)
+        res = linprog(np.r_[0, 0, 0, -1], A_ub=np.c_[n, norm], b_ub=d,
+                      bounds=[(None, None)] * 3 + [(0, None)])
+        if res.status != 0 or res.x[3] <= 0:
+            raise ValueError("the planes bound no volume (or an unbounded one)")
+        hs = HalfspaceIntersection(np.c_[n, -d], res.x[:3])
+        return cls.from_points(hs.intersections)
+
+    def transformed(self, matrix: np.ndarray) -> "ConvexPolytope":
+        """The polytope under an affine 4 x 4 map."""
+        return ConvexPolytope.from_points(self.vertices @ matrix[:3, :3].T + matrix[:3, 3])
+
+    def distance(self, points: Any, weights: Any = None) -> np.ndarray:
+        """Signed weighted max-norm distance (negative inside)."""
+        p = as_points(points)
+        w = as_weights(weights, len(p))
+        out = np.empty(len(p))
+        for s in range(0, len(p), CHUNK):
+            out[s:s + CHUNK] = self._distance(p[s:s + CHUNK], w[s:s + CHUNK])
+        return out
+
+    def _distance(self, p: np.ndarray, w: np.ndarray) -> np.ndarray:
+        slack = self.offsets[None, :] - p @ self.normals.T              # (n, F), >= 0 inside
+        inside = np.all(slack >= 0, axis=1)
+        h_faces = w @ np.abs(self.normals).T
+        d_in = -np.min(slack / h_faces, axis=1)
+        h_axes = w @ np.abs(self.axes).T                                  # (n, A)
+        d_out = np.max((self.low[None, :] - p @ self.axes.T) / h_axes, axis=1)
+        return np.where(inside, d_in, d_out)
+
+    @property
+    def bounds(self):
+        return tuple(self.vertices.min(0).tolist()), tuple(self.vertices.max(0).tolist())
+
+    def classify_boxes(self, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+        from .classify import classify_by_distance
+        return classify_by_distance(self.distance, lo, hi)
+
+
+class HalfSpace:
+    """``n . x <= d``: signed distance ``(n.p - d) / h_w(n)`` (exactly, on both sides)."""
+
+    def __init__(self, normal: Any, offset: float):
+        n = np.asarray(normal, dtype=np.float64).reshape(3)
+        if not np.any(n != 0) or not np.all(np.isfinite(n)):
+            raise ValueError("normal must be finite and non-zero")
+        self.normal, self.offset = n, float(offset)
+
+    def distance(self, points: Any, weights: Any = None) -> np.ndarray:
+        p = as_points(points)
+        w = as_weights(weights, len(p))
+        return (p @ self.normal - self.offset) / (w @ np.abs(self.normal))
+
+    def classify_boxes(self, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+        from .classify import classify_by_distance
+        return classify_by_distance(self.distance, lo, hi)
+
+
+def triangle_distance(points: np.ndarray, tri: np.ndarray,
+                      weights: Optional[np.ndarray] = None) -> np.ndarray:
+    """Unsigned weighted max-norm distance from ``points[k]`` to triangle ``tri[k]`` (3, 3).
+
+    The 13 separating axes of a box and a triangle (box normals, the normal,
+    box axes crossed with the edges), each with both signs; degenerate axes
+    (zero normal or edge) are skipped.
+    """
+    p = np.asarray(points, dtype=np.float64)
+    w = as_weights(weights, len(p))
+    v0, v1, v2 = tri[:, 0], tri[:, 1], tri[:, 2]
+    edges = (v1 - v0, v2 - v1, v0 - v2)
+    axes = [np.broadcast_to(np.eye(3)[i], p.shape) for i in range(3)]
+    axes.append(np.cross(edges[0], v2 - v0))
+    for e in edges:
+        for i in range(3):
+            axes.append(np.cross(np.broadcast_to(np.eye(3)[i], e.shape), e))
+    best = np.zeros(len(p))
+    with np.errstate(invalid="ignore", divide="ignore"):
+        for u in axes:
+            h = np.sum(np.abs(u) * w, axis=1)
+            a, b, c, q = (np.einsum("ij,ij->i", u, v) for v in (v0, v1, v2, p))
+            lo = np.minimum(np.minimum(a, b), c)
+            hi = np.maximum(np.maximum(a, b), c)
+            gap = np.maximum(lo - q, q - hi) / h
+            best = np.fmax(best, np.where(h > 0, gap, 0.0))
+    return best

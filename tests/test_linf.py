@@ -1,0 +1,168 @@
+"""Max-norm distances against independent brute force, and exact voxel tests (Varadhan)."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from scipy.optimize import linprog
+
+import implicitvox as ivx
+from implicitvox import linf
+from implicitvox.shape import AMBIGUOUS, EMPTY, FULL
+
+CUBE = np.array([[x, y, z] for x in (0, 1) for y in (0, 1) for z in (0, 1)], dtype=float)
+
+
+def _rotation(rng):
+    q, _ = np.linalg.qr(rng.normal(size=(3, 3)))
+    return q
+
+
+def lp_distance(poly: linf.ConvexPolytope, p, w):
+    """Brute force outside a polytope: min t s.t. A x <= b, |x - p| <= t w (a linear programme)."""
+    A, b = poly.normals, poly.offsets
+    # variables (x, t): minimise t
+    rows = [np.c_[A, np.zeros(len(A))]]
+    rhs = [b]
+    for s in (1, -1):
+        rows.append(np.c_[s * np.eye(3), -w[:, None]])
+        rhs.append(s * p)
+    res = linprog(np.r_[0, 0, 0, 1], A_ub=np.vstack(rows), b_ub=np.concatenate(rhs),
+                  bounds=[(None, None)] * 3 + [(0, None)], method="highs")
+    return res.fun
+
+
+def lp_depth(poly, p, w):
+    """Brute force inside: the largest box around p inside the polytope (a linear programme)."""
+    A, b = poly.normals, poly.offsets
+    h = np.abs(A) @ w
+    res = linprog([-1], A_ub=h[:, None], b_ub=b - A @ p, bounds=[(0, None)], method="highs")
+    return -res.x[0]
+
+
+@pytest.mark.parametrize("name", ["cube", "rotated box", "random hull", "octahedron"])
+def test_polytope_matches_linear_programming(name):
+    rng = np.random.default_rng(len(name))
+    pts = {"cube": CUBE, "rotated box": (CUBE - 0.5) * [1, 2, 0.5] @ _rotation(rng).T,
+           "random hull": rng.normal(size=(30, 3)),
+           "octahedron": np.vstack([np.eye(3), -np.eye(3)])}[name]
+    poly = linf.ConvexPolytope.from_points(pts)
+    n = 1500
+    p = rng.normal(size=(n, 3)) * 1.5
+    # also points near vertices and edges, where the contact is a vertex or an edge
+    v = poly.vertices[rng.integers(0, len(poly.vertices), n // 3)]
+    p[: n // 3] = v + rng.normal(size=v.shape) * 1e-3
+    w = rng.uniform(0.3, 2.0, size=(n, 3))
+    d = poly.distance(p, w)
+    for i in range(n):
+        want = lp_distance(poly, p[i], w[i]) if d[i] > 0 else lp_depth(poly, p[i], w[i])
+        assert d[i] == pytest.approx(want, rel=1e-9, abs=1e-12), (i, p[i])
+
+
+def test_halfspace_both_sides():
+    h = linf.HalfSpace((1, -2, 0.5), 0.3)
+    rng = np.random.default_rng(1)
+    p = rng.normal(size=(10_000, 3))
+    w = rng.uniform(0.5, 2, (10_000, 3))
+    d = h.distance(p, w)
+    # the box of radius |d| around p touches the plane: its extreme corner lies on it
+    corner = p - np.sign(d)[:, None] * np.sign(h.normal) * np.abs(d)[:, None] * w
+    assert np.allclose(corner @ h.normal, h.offset, atol=1e-12)
+
+
+def sphere_bisection(c, r, p, w):
+    """Brute force: bisection on t of 'the box B(p, t) meets the ball' (outside) or
+    'the box lies in the ball' (inside), each a Euclidean test."""
+    a = np.abs(p - c)
+    inside = np.dot(a, a) < r * r
+    lo, hi = 0.0, 10.0
+    for _ in range(200):
+        t = 0.5 * (lo + hi)
+        if inside:
+            ok = np.linalg.norm(a + t * w) <= r
+        else:
+            ok = np.linalg.norm(np.maximum(a - t * w, 0)) > r
+        lo, hi = (t, hi) if ok else (lo, t)
+    return -lo if inside else lo
+
+
+def test_sphere_matches_bisection_and_sampling():
+    rng = np.random.default_rng(2)
+    s = linf.Sphere((0.1, -0.2, 0.3), 0.8)
+    n = 10_000
+    p = rng.normal(size=(n, 3))
+    p[:100] = s.center                                      # the centre itself
+    p[100:200, 1:] = s.center[1:]                           # on an axis through the centre
+    w = rng.uniform(0.5, 2, (n, 3))
+    d = s.distance(p, w)
+    for i in range(0, n, 10):
+        assert d[i] == pytest.approx(sphere_bisection(s.center, s.r, p[i], w[i]), rel=1e-9,
+                                     abs=1e-12)
+    # no sampled surface point is nearer than the distance (an upper bound check)
+    u = rng.normal(size=(20_000, 3))
+    surf = s.center + s.r * u / np.linalg.norm(u, axis=1, keepdims=True)
+    for i in range(0, 200, 7):
+        nearest = np.min(np.max(np.abs(surf - p[i]) / w[i], axis=1))
+        assert nearest >= abs(d[i]) * (1 - 1e-9)
+
+
+def test_mesh_matches_brute_force():
+    import pyvista as pv
+    from implicitvox.mesh_input import as_triangles
+    v, f = as_triangles(pv.examples.load_nut())
+    mesh = linf.TriangleMesh(v, f)
+    rng = np.random.default_rng(3)
+    lo, hi = v.min(0), v.max(0)
+    p = rng.uniform(lo - 5, hi + 5, (300, 3))
+    w = rng.uniform(0.5, 2, (300, 3))
+    d = mesh.distance(p, w)
+    tri = v[f]
+    for i in range(len(p)):
+        bf = linf.triangle_distance(np.repeat(p[i:i + 1], len(tri), 0), tri,
+                                    np.repeat(w[i:i + 1], len(tri), 0)).min()
+        assert abs(d[i]) == pytest.approx(bf, rel=1e-12, abs=1e-12)
+    assert mesh.closed and (d < 0).any() and (d > 0).any()
+
+
+def _brute_classify_sphere(c, r, lo, hi):
+    """A box against a sphere's surface, Euclidean: the nearest and farthest box points."""
+    near = np.linalg.norm(np.maximum(np.maximum(lo - c, c - hi), 0), axis=1)
+    far = np.linalg.norm(np.maximum(np.abs(lo - c), np.abs(hi - c)), axis=1)
+    out = np.full(len(lo), AMBIGUOUS)
+    out[near > r] = EMPTY
+    out[far < r] = FULL
+    return out, np.minimum(np.abs(near - r), np.abs(far - r))
+
+
+def test_sphere_classification_on_a_million_boxes():
+    rng = np.random.default_rng(4)
+    s = linf.Sphere((0, 0, 0), 1.0)
+    lo = rng.uniform(-1.5, 1.5, (10**6, 3))
+    hi = lo + rng.uniform(1e-3, 0.5, (10**6, 3))
+    got = s.classify_boxes(lo, hi)
+    want, margin = _brute_classify_sphere(s.center, s.r, lo, hi)
+    bad = got != want
+    assert np.all(margin[bad] < 1e-12)              # disagreements only at exact ties
+    assert (want == AMBIGUOUS).sum() > 10**5
+
+
+def test_voxelizing_a_sphere_gives_exactly_the_voxels_it_meets():
+    s = linf.Sphere((0.013, -0.021, 0.007), 0.77)
+    vox = ivx.voxelize(s, bounds=((-1, -1, -1), (1, 1, 1)), resolution=64)
+    every = np.stack(np.meshgrid(*[np.arange(64)] * 3, indexing="ij"), -1).reshape(-1, 3)
+    g = vox.grid
+    lo = np.stack([g.edge(a, every[:, a]) for a in range(3)], 1)
+    hi = np.stack([g.edge(a, every[:, a] + 1) for a in range(3)], 1)
+    want, margin = _brute_classify_sphere(s.center, s.r, lo, hi)
+    got = vox.contains(every)
+    assert np.all((got == (want == AMBIGUOUS)) | (margin < 1e-12))
+    assert got.sum() > 0
+
+
+def test_public_entry_point_and_errors():
+    assert ivx.linf_distance(linf.HalfSpace((0, 0, 1), 0), [[0, 0, 2]]).tolist() == [2.0]
+    with pytest.raises(TypeError, match="no max-norm distance"):
+        ivx.linf_distance(object(), [[0, 0, 0]])
+    with pytest.raises(ValueError, match="weights must be positive"):
+        linf.Sphere((0, 0, 0), 1).distance([[1, 2, 3]], weights=(1, 0, 1))
+    with pytest.raises(ValueError, match=r"points must have shape \(n, 3\)"):
+        linf.Sphere((0, 0, 0), 1).distance([[1, 2]])
