@@ -1,13 +1,17 @@
 """Exact box classification of CSG trees with polyhedral leaves.
 
 A CSG tree is flattened to world space: transforms are pushed into the
-leaves (a :class:`~csg.primitives.Polyhedron`'s vertices are moved; any
-other subtree becomes one compiled implicit function). Each leaf classifies
-boxes as EMPTY, FULL or AMBIGUOUS:
+leaves (a :class:`~csg.primitives.Polyhedron`'s vertices are moved, a box's
+or convex polyhedron's corners, a half-space's plane, a sphere under a
+similarity; any other subtree becomes one compiled implicit function). Each
+leaf classifies boxes as EMPTY, FULL or AMBIGUOUS:
 
 * a polyhedron exactly - AMBIGUOUS iff a triangle meets the closed box
   (:class:`implicitvox.tribox.Triangles`), else FULL or EMPTY by the winding
   number at the box's centre;
+* boxes, convex polyhedra, half-spaces and spheres by their max-norm
+  distance (Varadhan §5.1, :mod:`implicitvox.linf`): AMBIGUOUS iff the
+  surface meets the box (up to rounding at exact ties);
 * a function by its interval enclosure (sound; AMBIGUOUS may be a near miss).
 
 The booleans combine the states: a union is FULL if a child is, EMPTY if all
@@ -30,9 +34,45 @@ from implicitvox.mesh_subdivide import _sorted_unique
 __all__ = ["exact_classifier", "MeshClassifier"]
 
 
+def _exact_types():
+    from .primitives import Box, ConvexPolyhedron, HalfSpace, Polyhedron, Sphere
+    return (Polyhedron, Box, ConvexPolyhedron, HalfSpace, Sphere)
+
+
 def _has_mesh(solid) -> bool:
-    from .primitives import Polyhedron
-    return isinstance(solid, Polyhedron) or any(_has_mesh(c) for c in solid.children)
+    """Whether a leaf of the tree has an exact test (a polyhedron or a max-norm primitive)."""
+    return isinstance(solid, _exact_types()) or any(_has_mesh(c) for c in solid.children)
+
+
+def _linf_leaf(solid, matrix: np.ndarray):
+    """The leaf as a max-norm primitive in world space (implicitvox.linf), or None."""
+    from implicitvox import linf
+    from .primitives import Box, ConvexPolyhedron, HalfSpace, Sphere
+    m, t = matrix[:3, :3], matrix[:3, 3]
+    if isinstance(solid, Box):
+        lo, hi = (np.asarray(b) for b in solid.bounds)
+        corners = np.array([[(lo, hi)[(k >> a) & 1][a] for a in range(3)] for k in range(8)])
+        return linf.ConvexPolytope.from_points(corners @ m.T + t)
+    if isinstance(solid, ConvexPolyhedron):
+        if solid._points is not None:
+            return linf.ConvexPolytope.from_points(solid._points @ m.T + t)
+        return linf.ConvexPolytope.from_planes(solid.normals, solid.offsets).transformed(matrix)
+    if isinstance(solid, HalfSpace):
+        n = np.linalg.solve(m.T, solid.normal)          # M^-T n
+        return linf.HalfSpace(n, solid.offset + n @ t)
+    if isinstance(solid, Sphere):
+        gram = m.T @ m
+        scale2 = gram[0, 0]
+        if np.allclose(gram, scale2 * np.eye(3), rtol=1e-12, atol=0):   # a similarity
+            return linf.Sphere(m @ solid.center + t, solid.r * np.sqrt(scale2))
+    return None
+
+
+def _leaves(solid):
+    if not solid.children:
+        yield solid
+    for c in solid.children:
+        yield from _leaves(c)
 
 
 def exact_classifier(solid) -> Optional[Callable[[np.ndarray, np.ndarray], np.ndarray]]:
@@ -57,8 +97,21 @@ def _plan(solid, matrix: np.ndarray) -> tuple:
         v = solid.vertices @ matrix[:3, :3].T + matrix[:3, 3]
         flip = np.linalg.det(matrix[:3, :3]) < 0      # mirrored: the winding sign flips
         return ("mesh", MeshClassifier(v, solid.faces, flip))
+    if isinstance(solid, _exact_types()):
+        prim = _linf_leaf(solid, matrix)
+        if prim is not None:
+            return ("exact", prim)
+        return ("function", iv.compile(Transformed(solid, matrix).expr))
     if isinstance(solid, Transformed):
         return _plan(solid.children[0], matrix @ solid.matrix)
+    if not isinstance(solid, (Union, Intersection, Difference, Complement)):
+        from .primitives import Polyhedron as _P
+        if any(isinstance(leaf, _P) for leaf in _leaves(solid)):
+            raise TypeError(f"{type(solid).__name__} with a polyhedron inside has no exact "
+                            "test (only booleans and transforms combine them)")
+        # another node (a blend, an extrusion): its own function, by intervals
+        return ("function", iv.compile(Transformed(solid, matrix).expr
+                                       if not np.array_equal(matrix, np.eye(4)) else solid.expr))
     kids = [_plan(c, matrix) for c in solid.children]
     if isinstance(solid, Union):
         return ("union", kids)
@@ -81,6 +134,8 @@ def _run(plan: tuple, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
         return state
     if kind == "mesh":
         return plan[1].classify(lo, hi)
+    if kind == "exact":
+        return plan[1].classify_boxes(lo, hi)
     if kind == "complement":
         s = _run(plan[1], lo, hi)
         return np.where(s == FULL, EMPTY, np.where(s == EMPTY, FULL, s)).astype(np.int8)

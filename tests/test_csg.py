@@ -108,9 +108,21 @@ def test_polyhedron_classification_is_exact():
     assert classify(lo, lo + 0.2).tolist() == [FULL, EMPTY, AMBIGUOUS]
 
 
-def test_plain_solids_have_no_exact_test():
-    assert Sphere(1).classify_boxes is None
-    assert (Sphere(1) - Polyhedron(SPHERE_MESH)).classify_boxes is not None
+def test_which_solids_have_an_exact_test():
+    assert Torus(1, 0.2).classify_boxes is None
+    assert csg.ExprSolid(ivx.x ** 2 - 1).classify_boxes is None
+    assert Sphere(1).classify_boxes is not None               # max-norm distance
+    assert (Torus(1, 0.2) - Polyhedron(SPHERE_MESH)).classify_boxes is not None
+
+
+def test_exact_leaves_settle_boxes_intervals_cannot():
+    """A rotated box: intervals of its max-of-abs function stay AMBIGUOUS on boxes near a
+    rotated corner that the max-norm test settles; both never drop a surface voxel."""
+    box = Box((1, 2, 3)).rotate((1, 1, 0), 37).translate((0.1, 0.2, 0.3))
+    exact = box.voxelize(48)
+    loose = ivx.voxelize(box.expr, exact.bounds, 48)
+    assert np.all(loose.contains(exact.coords()))
+    assert exact.count < loose.count
 
 
 def test_transforms_compose_and_invert():

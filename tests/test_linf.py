@@ -166,3 +166,25 @@ def test_public_entry_point_and_errors():
         linf.Sphere((0, 0, 0), 1).distance([[1, 2, 3]], weights=(1, 0, 1))
     with pytest.raises(ValueError, match=r"points must have shape \(n, 3\)"):
         linf.Sphere((0, 0, 0), 1).distance([[1, 2]])
+
+
+def test_voxelizing_a_rotated_box_gives_exactly_the_voxels_it_meets():
+    """Oracle: the exact box-triangle test against the box's 12 faces (another algorithm)."""
+    from implicitvox.tribox import Triangles
+    rng = np.random.default_rng(5)
+    corners = (CUBE - 0.5) * [1.3, 0.9, 0.6] @ _rotation(rng).T + 0.05
+    poly = linf.ConvexPolytope.from_points(corners)
+    vox = ivx.voxelize(poly, bounds=((-1, -1, -1), (1, 1, 1)), resolution=48)
+    from scipy.spatial import ConvexHull
+    faces = ConvexHull(corners).simplices
+    tris = Triangles(corners[faces])
+    every = np.stack(np.meshgrid(*[np.arange(48)] * 3, indexing="ij"), -1).reshape(-1, 3)
+    g = vox.grid
+    lo = np.stack([g.edge(a, every[:, a]) for a in range(3)], 1)
+    hi = np.stack([g.edge(a, every[:, a] + 1) for a in range(3)], 1)
+    want = np.zeros(len(every), dtype=bool)
+    for t in range(len(faces)):
+        want |= tris.meet_boxes(np.full(len(every), t), lo, hi)
+    got = vox.contains(every)
+    assert want.sum() > 1000
+    assert np.array_equal(got, want)

@@ -120,6 +120,14 @@ class ConvexPolytope:
         return np.where(inside, d_in, d_out)
 
     @property
+    def expr(self):
+        """``max_f (n_f . x - d_f)``: the implicit function (a Shape for the voxelizer)."""
+        import implicitvox as iv
+        terms = [n[0] * iv.x + n[1] * iv.y + n[2] * iv.z - d
+                 for n, d in zip(self.normals, self.offsets)]
+        return iv.max(*terms)
+
+    @property
     def bounds(self):
         return tuple(self.vertices.min(0).tolist()), tuple(self.vertices.max(0).tolist())
 
@@ -136,6 +144,12 @@ class HalfSpace:
         if not np.any(n != 0) or not np.all(np.isfinite(n)):
             raise ValueError("normal must be finite and non-zero")
         self.normal, self.offset = n, float(offset)
+
+    @property
+    def expr(self):
+        import implicitvox as iv
+        n = self.normal
+        return n[0] * iv.x + n[1] * iv.y + n[2] * iv.z - self.offset
 
     def distance(self, points: Any, weights: Any = None) -> np.ndarray:
         p = as_points(points)
