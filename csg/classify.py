@@ -9,7 +9,8 @@ leaf classifies boxes as EMPTY, FULL or AMBIGUOUS:
 * a polyhedron exactly - AMBIGUOUS iff a triangle meets the closed box
   (:class:`implicitvox.tribox.Triangles`), else FULL or EMPTY by the winding
   number at the box's centre;
-* boxes, convex polyhedra, half-spaces and spheres by their max-norm
+* boxes, convex polyhedra, half-spaces, spheres and ellipsoids (under any
+  affine map) by their max-norm
   distance (Varadhan §5.1, :mod:`implicitvox.linf`): AMBIGUOUS iff the
   surface meets the box (up to rounding at exact ties);
 * a function by its interval enclosure (sound; AMBIGUOUS may be a near miss).
@@ -35,8 +36,8 @@ __all__ = ["exact_classifier", "MeshClassifier"]
 
 
 def _exact_types():
-    from .primitives import Box, ConvexPolyhedron, HalfSpace, Polyhedron, Sphere
-    return (Polyhedron, Box, ConvexPolyhedron, HalfSpace, Sphere)
+    from .primitives import Box, ConvexPolyhedron, Ellipsoid, HalfSpace, Polyhedron, Sphere
+    return (Polyhedron, Box, ConvexPolyhedron, HalfSpace, Sphere, Ellipsoid)
 
 
 def _has_mesh(solid) -> bool:
@@ -47,7 +48,7 @@ def _has_mesh(solid) -> bool:
 def _linf_leaf(solid, matrix: np.ndarray):
     """The leaf as a max-norm primitive in world space (implicitvox.linf), or None."""
     from implicitvox import linf
-    from .primitives import Box, ConvexPolyhedron, HalfSpace, Sphere
+    from .primitives import Box, ConvexPolyhedron, Ellipsoid, HalfSpace, Sphere
     m, t = matrix[:3, :3], matrix[:3, 3]
     if isinstance(solid, Box):
         lo, hi = (np.asarray(b) for b in solid.bounds)
@@ -65,6 +66,9 @@ def _linf_leaf(solid, matrix: np.ndarray):
         scale2 = gram[0, 0]
         if np.allclose(gram, scale2 * np.eye(3), rtol=1e-12, atol=0):   # a similarity
             return linf.Sphere(m @ solid.center + t, solid.r * np.sqrt(scale2))
+        return linf.Ellipsoid.from_affine(m * solid.r, m @ solid.center + t)
+    if isinstance(solid, Ellipsoid):
+        return linf.Ellipsoid.from_affine(m @ np.diag(solid.radii), m @ solid.center + t)
     return None
 
 

@@ -188,3 +188,74 @@ def test_voxelizing_a_rotated_box_gives_exactly_the_voxels_it_meets():
     got = vox.contains(every)
     assert want.sum() > 1000
     assert np.array_equal(got, want)
+
+
+def test_ellipsoid_matches_a_convex_programme():
+    """Brute force: min t s.t. x in E, |x - p| <= t w (outside), or the largest box of
+    corners in E (inside), each solved by SLSQP from two starts."""
+    from scipy.optimize import minimize
+    rng = np.random.default_rng(6)
+    e = linf.Ellipsoid((0.1, -0.2, 0.3), (1.5, 0.7, 0.4), _rotation(rng))
+    p = rng.normal(size=(300, 3)) * 1.5
+    w = rng.uniform(0.5, 2, (300, 3))
+    d = e.distance(p, w)
+    signs = np.array([[a, b, c] for a in (-1, 1) for b in (-1, 1) for c in (-1, 1)])
+
+    def inside(v):
+        return 1 - (v - e.center) @ e.Q @ (v - e.center)
+
+    for i in range(len(p)):
+        if d[i] > 0:
+            cons = [{"type": "ineq", "fun": lambda v: inside(v[:3])},
+                    {"type": "ineq", "fun": lambda v, i=i: v[3] * w[i] - (v[:3] - p[i])},
+                    {"type": "ineq", "fun": lambda v, i=i: v[3] * w[i] + (v[:3] - p[i])}]
+            best = min(minimize(lambda v: v[3], np.r_[s, 5.0], constraints=cons, method="SLSQP",
+                                options={"ftol": 1e-15, "maxiter": 500}).fun
+                       for s in (e.center, p[i]))
+        else:                  # bisection: the largest box whose 8 corners are in E
+            a, b = 0.0, 10.0
+            for _ in range(100):
+                t = 0.5 * (a + b)
+                a, b = (t, b) if all(inside(p[i] + t * s * w[i]) >= 0 for s in signs) \
+                    else (a, t)
+            best = -a
+        assert d[i] == pytest.approx(best, rel=1e-7, abs=1e-9), i
+    sphere = linf.Sphere((0.1, 0.2, 0.3), 0.8)
+    as_ellipsoid = linf.Ellipsoid((0.1, 0.2, 0.3), (0.8, 0.8, 0.8))
+    q = rng.normal(size=(10_000, 3))
+    ww = rng.uniform(0.5, 2, (10_000, 3))
+    assert np.allclose(as_ellipsoid.distance(q, ww), sphere.distance(q, ww), rtol=1e-12,
+                       atol=1e-14)
+
+
+def test_voxelizing_a_rotated_ellipsoid_gives_exactly_the_voxels_it_meets():
+    """Oracle: a voxel meets the surface iff the quadric's minimum over the box is <= 1
+    and its maximum (at a corner: the quadric is convex) is >= 1; the minimum over the
+    box by a bounded QP (L-BFGS-B), checked only away from ties."""
+    from scipy.optimize import minimize
+    rng = np.random.default_rng(7)
+    e = linf.Ellipsoid((0.05, -0.03, 0.02), (0.9, 0.5, 0.3), _rotation(rng))
+    vox = ivx.voxelize(e, bounds=((-1, -1, -1), (1, 1, 1)), resolution=32)
+    every = np.stack(np.meshgrid(*[np.arange(32)] * 3, indexing="ij"), -1).reshape(-1, 3)
+    g = vox.grid
+    lo = np.stack([g.edge(a, every[:, a]) for a in range(3)], 1)
+    hi = np.stack([g.edge(a, every[:, a] + 1) for a in range(3)], 1)
+    corners = lo[:, None, :] + signs_box()[None] * (hi - lo)[:, None, :]
+    y = corners - e.center
+    qmax = np.einsum("nci,ij,ncj->nc", y, e.Q, y).max(axis=1)
+    got = vox.contains(every)
+    checked = 0
+    for k in np.flatnonzero(qmax >= 1):
+        f = lambda v: (v - e.center) @ e.Q @ (v - e.center)
+        r = minimize(f, 0.5 * (lo[k] + hi[k]), bounds=list(zip(lo[k], hi[k])), method="L-BFGS-B",
+                     jac=lambda v: 2 * e.Q @ (v - e.center), options={"ftol": 1e-15, "gtol": 1e-12})
+        qmin = r.fun
+        if abs(qmin - 1) > 1e-6 and abs(qmax[k] - 1) > 1e-9:
+            assert got[k] == (qmin <= 1), k
+            checked += 1
+    assert not got[qmax < 1 - 1e-9].any()              # voxels inside: never output
+    assert checked > 1000
+
+
+def signs_box():
+    return np.array([[a, b, c] for a in (0, 1) for b in (0, 1) for c in (0, 1)], dtype=float)

@@ -8,11 +8,12 @@ the surface meets the closed box - exactly, up to rounding at ties
 
 * :class:`HalfSpace`, :class:`ConvexPolytope` (boxes, oriented boxes, any
   bounded intersection of half-spaces or convex hull) - §3.1.1, §3.1.2;
-* :class:`Sphere` - §3.2 (contact equations);
+* :class:`Sphere`, :class:`Ellipsoid` (any rigid motion) - §3.2 (contact
+  equations: vertex, edge and face contacts of the box);
 * :func:`triangle_distance` and :class:`TriangleMesh` (culling by upper and
   lower bounds) - §3.3, §4.1.
 
-Not yet here: ellipsoids and general quadrics, capped cylinders and cones,
+Not yet here: general (non-ellipsoidal) quadrics, capped cylinders and cones,
 the torus.
 
 Examples
@@ -32,8 +33,9 @@ from .classify import classify_by_distance
 from .mesh import TriangleMesh
 from .polytope import ConvexPolytope, HalfSpace, triangle_distance
 from .sphere import Sphere
+from .ellipsoid import Ellipsoid
 
-__all__ = ["linf_distance", "HalfSpace", "ConvexPolytope", "Sphere", "TriangleMesh",
+__all__ = ["linf_distance", "HalfSpace", "ConvexPolytope", "Sphere", "Ellipsoid", "TriangleMesh",
            "triangle_distance", "classify_by_distance"]
 
 
@@ -44,8 +46,7 @@ def linf_distance(shape: Any, points: Any, weights: Any = None) -> np.ndarray:
     ``linf_distance(points, weights)`` method (as :mod:`csg` solids with
     exact leaves have).
     """
-    if hasattr(shape, "distance") and isinstance(shape, (HalfSpace, ConvexPolytope, Sphere,
-                                                         TriangleMesh)):
+    if isinstance(shape, (HalfSpace, ConvexPolytope, Sphere, Ellipsoid, TriangleMesh)):
         return shape.distance(points, weights)
     method = getattr(shape, "linf_distance", None)
     if callable(method):
