@@ -95,16 +95,17 @@ class Ellipsoid:
         p = as_points(points)
         w = as_weights(weights, len(p))
         y = p - self.center
-        level = np.einsum("ni,ij,nj->n", y, self.Q, y)
+        level = np.sum((y @ self.Q) * y, axis=1)
         out = np.empty(len(p))
         inside = level <= 1
         out[inside] = -self._depth(y[inside], w[inside], level[inside])
         out[~inside] = self._gap(y[~inside], w[~inside], level[~inside])
         return out
 
-    def _ray(self, y, d, level):
-        A = np.einsum("ni,ij,nj->n", d, self.Q, d)
-        B = np.einsum("ni,ij,nj->n", d, self.Q, y)
+    def _ray(self, y, d, level, Qy=None):
+        Qd = d @ self.Q
+        A = np.sum(Qd * d, axis=1)
+        B = np.sum(Qd * y, axis=1)
         return _roots(A, B, level - 1)
 
     def _depth(self, y, w, level):
@@ -122,13 +123,14 @@ class Ellipsoid:
         Q = self.Q
         for i, j, k in _EDGES:                              # edge contacts
             P = Q[np.ix_([i, j], [i, j])] - np.outer(Q[[i, j], k], Q[k, [i, j]]) / Q[k, k]
+            z0 = y[:, [i, j]]
+            Pz0 = z0 @ P
+            C = np.sum(Pz0 * z0, axis=1) - 1                   # the same for the 4 edges
             for si in (-1.0, 1.0):
                 for sj in (-1.0, 1.0):
-                    z0 = y[:, [i, j]]
                     dz = np.stack([si * w[:, i], sj * w[:, j]], axis=1)
-                    A = np.einsum("ni,ij,nj->n", dz, P, dz)
-                    B = np.einsum("ni,ij,nj->n", dz, P, z0)
-                    C = np.einsum("ni,ij,nj->n", z0, P, z0) - 1
+                    A = np.sum((dz @ P) * dz, axis=1)
+                    B = np.sum(Pz0 * dz, axis=1)
                     t1, _ = _roots(A, B, C)
                     t1 = np.where((C > 0) & (t1 >= 0), t1, np.nan)
                     z = z0 + t1[:, None] * dz

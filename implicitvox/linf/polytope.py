@@ -167,24 +167,36 @@ def triangle_distance(points: np.ndarray, tri: np.ndarray,
 
     The 13 separating axes of a box and a triangle (box normals, the normal,
     box axes crossed with the edges), each with both signs; degenerate axes
-    (zero normal or edge) are skipped.
+    (zero normal or edge) are skipped. Written per coordinate: a box axis
+    crossed with an edge has one zero component.
     """
     p = np.asarray(points, dtype=np.float64)
     w = as_weights(weights, len(p))
-    v0, v1, v2 = tri[:, 0], tri[:, 1], tri[:, 2]
-    edges = (v1 - v0, v2 - v1, v0 - v2)
-    axes = [np.broadcast_to(np.eye(3)[i], p.shape) for i in range(3)]
-    axes.append(np.cross(edges[0], v2 - v0))
-    for e in edges:
-        for i in range(3):
-            axes.append(np.cross(np.broadcast_to(np.eye(3)[i], e.shape), e))
+    P = [p[:, a] for a in range(3)]
+    V = [[tri[:, k, a] for a in range(3)] for k in range(3)]
+    W = [w[:, a] for a in range(3)]
     best = np.zeros(len(p))
     with np.errstate(invalid="ignore", divide="ignore"):
-        for u in axes:
-            h = np.sum(np.abs(u) * w, axis=1)
-            a, b, c, q = (np.einsum("ij,ij->i", u, v) for v in (v0, v1, v2, p))
-            lo = np.minimum(np.minimum(a, b), c)
-            hi = np.maximum(np.maximum(a, b), c)
-            gap = np.maximum(lo - q, q - hi) / h
-            best = np.fmax(best, np.where(h > 0, gap, 0.0))
+        for a in range(3):                                    # box normals: the bounding box
+            lo = np.minimum(np.minimum(V[0][a], V[1][a]), V[2][a])
+            hi = np.maximum(np.maximum(V[0][a], V[1][a]), V[2][a])
+            best = np.fmax(best, np.maximum(lo - P[a], P[a] - hi) / W[a])
+
+        def along(u):                                        # u: 3 components (or 0)
+            h = sum(np.abs(u[a]) * W[a] for a in range(3) if u[a] is not None)
+            dots = [sum(u[a] * V[k][a] for a in range(3) if u[a] is not None) for k in range(3)]
+            q = sum(u[a] * P[a] for a in range(3) if u[a] is not None)
+            lo = np.minimum(np.minimum(dots[0], dots[1]), dots[2])
+            hi = np.maximum(np.maximum(dots[0], dots[1]), dots[2])
+            return np.where(h > 0, np.maximum(lo - q, q - hi) / h, 0.0)
+
+        e = [[V[(k + 1) % 3][a] - V[k][a] for a in range(3)] for k in range(3)]
+        f = [V[2][a] - V[0][a] for a in range(3)]
+        normal = [e[0][1] * f[2] - e[0][2] * f[1], e[0][2] * f[0] - e[0][0] * f[2],
+                  e[0][0] * f[1] - e[0][1] * f[0]]
+        best = np.fmax(best, along(normal))
+        for ed in e:                                          # e_i x edge
+            best = np.fmax(best, along([None, -ed[2], ed[1]]))
+            best = np.fmax(best, along([ed[2], None, -ed[0]]))
+            best = np.fmax(best, along([-ed[1], ed[0], None]))
     return best
