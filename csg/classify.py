@@ -10,7 +10,7 @@ leaf classifies boxes as EMPTY, FULL or AMBIGUOUS:
   (:class:`implicitvox.tribox.Triangles`), else FULL or EMPTY by the winding
   number at the box's centre;
 * boxes, convex polyhedra, half-spaces, spheres and ellipsoids (under any
-  affine map) by their max-norm
+  affine map) and capped cylinders (under similarities) by their max-norm
   distance (Varadhan §5.1, :mod:`implicitvox.linf`): AMBIGUOUS iff the
   surface meets the box (up to rounding at exact ties);
 * a function by its interval enclosure (sound; AMBIGUOUS may be a near miss).
@@ -36,8 +36,9 @@ __all__ = ["exact_classifier", "MeshClassifier"]
 
 
 def _exact_types():
-    from .primitives import Box, ConvexPolyhedron, Ellipsoid, HalfSpace, Polyhedron, Sphere
-    return (Polyhedron, Box, ConvexPolyhedron, HalfSpace, Sphere, Ellipsoid)
+    from .primitives import (Box, ConvexPolyhedron, Cylinder, Ellipsoid, HalfSpace, Polyhedron,
+                             Sphere)
+    return (Polyhedron, Box, ConvexPolyhedron, HalfSpace, Sphere, Ellipsoid, Cylinder)
 
 
 def _has_mesh(solid) -> bool:
@@ -48,7 +49,7 @@ def _has_mesh(solid) -> bool:
 def _linf_leaf(solid, matrix: np.ndarray):
     """The leaf as a max-norm primitive in world space (implicitvox.linf), or None."""
     from implicitvox import linf
-    from .primitives import Box, ConvexPolyhedron, Ellipsoid, HalfSpace, Sphere
+    from .primitives import Box, ConvexPolyhedron, Cylinder, Ellipsoid, HalfSpace, Sphere
     m, t = matrix[:3, :3], matrix[:3, 3]
     if isinstance(solid, Box):
         lo, hi = (np.asarray(b) for b in solid.bounds)
@@ -64,11 +65,35 @@ def _linf_leaf(solid, matrix: np.ndarray):
     if isinstance(solid, Sphere):
         gram = m.T @ m
         scale2 = gram[0, 0]
-        if np.allclose(gram, scale2 * np.eye(3), rtol=1e-12, atol=0):   # a similarity
+        if np.allclose(gram, scale2 * np.eye(3), rtol=0, atol=1e-12 * scale2):   # similarity
             return linf.Sphere(m @ solid.center + t, solid.r * np.sqrt(scale2))
         return linf.Ellipsoid.from_affine(m * solid.r, m @ solid.center + t)
     if isinstance(solid, Ellipsoid):
         return linf.Ellipsoid.from_affine(m @ np.diag(solid.radii), m @ solid.center + t)
+    if isinstance(solid, Cylinder) and solid.r1 == solid.r2:
+        gram = m.T @ m
+        scale2 = gram[0, 0]
+        if np.allclose(gram, scale2 * np.eye(3), rtol=0, atol=1e-12 * scale2):   # similarity
+            z0, _ = solid._z
+            k = np.sqrt(scale2)
+            return linf.Cylinder(m @ np.array([0.0, 0.0, z0]) + t, m[:, 2], solid.h * k,
+                                 solid.r1 * k)
+    return None
+
+
+def world_linf(solid, matrix: Optional[np.ndarray] = None):
+    """A single (transformed) primitive as a world-space max-norm primitive, or None."""
+    from implicitvox import linf
+    from .primitives import Polyhedron
+    from .solid import Transformed
+    matrix = np.eye(4) if matrix is None else matrix
+    if isinstance(solid, Transformed):
+        return world_linf(solid.children[0], matrix @ solid.matrix)
+    if isinstance(solid, Polyhedron):
+        v = solid.vertices @ matrix[:3, :3].T + matrix[:3, 3]
+        return linf.TriangleMesh(v, solid.faces)
+    if isinstance(solid, _exact_types()):
+        return _linf_leaf(solid, matrix)
     return None
 
 

@@ -130,6 +130,24 @@ class Solid:
             bounds = _padded(bounds)
         return iv.voxelize(self, bounds, resolution, **options)
 
+    def linf_distance(self, points: Any, weights: Any = None) -> np.ndarray:
+        """Signed weighted max-norm distance (Varadhan §3; :mod:`implicitvox.linf`) for a
+        primitive with one - box, convex polyhedron, half-space, sphere, ellipsoid or
+        polyhedron (a triangle mesh) - under any transforms.
+
+        Raises
+        ------
+        TypeError
+            For other solids (booleans, blends, ...): their exact box test combines
+            their leaves' tests instead (:attr:`classify_boxes`).
+        """
+        from .classify import world_linf
+        prim = world_linf(self)
+        if prim is None:
+            raise TypeError(f"no max-norm distance for {type(self).__name__}: only single "
+                            "primitives have one (booleans classify boxes leaf by leaf)")
+        return prim.distance(points, weights)
+
     def to_json(self, **kwargs: Any) -> str:
         """The solid as a JSON scene (:mod:`csg.scene`)."""
         from .scene import to_json

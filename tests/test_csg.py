@@ -194,3 +194,19 @@ HOSTILE = [
 def test_hostile_scenes(scene, match):
     with pytest.raises(SceneError, match=match):
         load_json(scene)
+
+
+def test_linf_distance_of_transformed_primitives():
+    rng = np.random.default_rng(9)
+    p = rng.normal(size=(2000, 3)) * 2
+    # a sphere under a non-uniform scale is an ellipsoid: compare with the kernel's
+    d = Sphere(1).scale((2, 1, 0.5)).linf_distance(p)
+    assert np.allclose(d, ivx.linf.Ellipsoid((0, 0, 0), (2, 1, 0.5)).distance(p), rtol=1e-12,
+                       atol=1e-14)
+    # a translated polyhedron (a closed mesh): signed, and 0 on its vertices
+    mesh = Polyhedron(SPHERE_MESH).translate((1, 0, 0))
+    v = np.asarray(SPHERE_MESH.points) + [1, 0, 0]
+    assert np.allclose(mesh.linf_distance(v), 0, atol=1e-12)
+    assert mesh.linf_distance([[1.0, 0.0, 0.0]])[0] < 0 < mesh.linf_distance([[3.0, 0, 0]])[0]
+    with pytest.raises(TypeError, match="only single primitives"):
+        (Sphere(1) | Box()).linf_distance(p)

@@ -259,3 +259,89 @@ def test_voxelizing_a_rotated_ellipsoid_gives_exactly_the_voxels_it_meets():
 
 def signs_box():
     return np.array([[a, b, c] for a in (0, 1) for b in (0, 1) for c in (0, 1)], dtype=float)
+
+
+def _cylinder_constraints(cyl):
+    def g(v):
+        y = v[:3] - cyl.c
+        s = y @ cyl.a
+        return np.array([s, cyl.h - s, cyl.r ** 2 - (y @ y - s * s)])
+    return g
+
+
+@pytest.mark.parametrize("axis", ["z", "x", "rotated"])
+def test_cylinder_matches_a_convex_programme(axis):
+    from scipy.optimize import minimize
+    rng = np.random.default_rng({"z": 10, "x": 11, "rotated": 12}[axis])
+    a = {"z": (0, 0, 1), "x": (1, 0, 0), "rotated": _rotation(rng)[:, 0]}[axis]
+    cyl = linf.Cylinder((0.1, 0.2, -0.3), a, 1.2, 0.5)
+    n = 150
+    p = rng.normal(size=(n, 3)) * 1.2
+    p[:20] = cyl.c + rng.uniform(-0.5, 1.7, (20, 1)) * cyl.a     # on the axis line
+    w = rng.uniform(0.5, 2, (n, 3))
+    d = cyl.distance(p, w)
+    g = _cylinder_constraints(cyl)
+    signs = np.array([[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)])
+    for i in range(n):
+        if d[i] > 0:
+            cons = [{"type": "ineq", "fun": g},
+                    {"type": "ineq", "fun": lambda v, i=i: v[3] * w[i] - (v[:3] - p[i])},
+                    {"type": "ineq", "fun": lambda v, i=i: v[3] * w[i] + (v[:3] - p[i])}]
+            best = np.inf
+            for start in (cyl.c + 0.5 * cyl.h * cyl.a, p[i], cyl.c, cyl.c + cyl.h * cyl.a):
+                r = minimize(lambda v: v[3], np.r_[start, 10.0], constraints=cons,
+                             method="SLSQP", options={"ftol": 1e-15, "maxiter": 1000})
+                # SLSQP may stop on a line-search note at the optimum: keep any feasible end
+                feasible = g(r.x).min() > -1e-9 and np.all(np.abs(r.x[:3] - p[i])
+                                                           <= r.x[3] * w[i] + 1e-9)
+                if feasible:
+                    best = min(best, r.x[3])
+        else:                  # bisection: the largest box whose 8 corners are in K
+            lo_t, hi_t = 0.0, 10.0
+            for _ in range(100):
+                t = 0.5 * (lo_t + hi_t)
+                ok = all(g(p[i] + t * s * w[i]).min() >= 0 for s in signs)
+                lo_t, hi_t = (t, hi_t) if ok else (lo_t, t)
+            best = -lo_t
+        assert d[i] == pytest.approx(best, rel=1e-7, abs=1e-9), (i, p[i])
+
+
+def test_voxelizing_a_rotated_cylinder_gives_exactly_the_voxels_it_meets():
+    """Oracle, away from ties: a voxel meets the surface iff it meets K (a feasibility
+    problem, SLSQP over the box) and not all 8 corners are in K (K is convex)."""
+    from scipy.optimize import minimize
+    rng = np.random.default_rng(13)
+    cyl = linf.Cylinder((-0.3, -0.2, -0.4), _rotation(rng)[:, 0], 1.1, 0.35)
+    vox = ivx.voxelize(cyl, bounds=((-1, -1, -1), (1, 1, 1)), resolution=32)
+    g = _cylinder_constraints(cyl)
+    every = np.stack(np.meshgrid(*[np.arange(32)] * 3, indexing="ij"), -1).reshape(-1, 3)
+    grid = vox.grid
+    lo = np.stack([grid.edge(a, every[:, a]) for a in range(3)], 1)
+    hi = np.stack([grid.edge(a, every[:, a] + 1) for a in range(3)], 1)
+    got = vox.contains(every)
+    corners = lo[:, None, :] + signs_box()[None] * (hi - lo)[:, None, :]
+    all_in = np.array([all(g(c).min() >= 0 for c in cs) for cs in corners])
+    assert not got[all_in].any()
+    centre = 0.5 * (lo + hi)
+    near = np.flatnonzero(~all_in & (np.linalg.norm(centre - (cyl.c + 0.55 * cyl.a), axis=1)
+                                     < 1.2))
+    checked = 0
+    for k in rng.choice(near, min(len(near), 1500), replace=False):
+        s_corners = (corners[k] - cyl.c) @ cyl.a
+        if s_corners.max() < 0 or s_corners.min() > cyl.h:      # the box misses the slab
+            assert not got[k]
+            checked += 1
+            continue
+
+        def rho2(x):
+            y = x - cyl.c
+            return y @ y - (y @ cyl.a) ** 2
+        # min of the (convex) squared distance to the axis over box and slab: a QP
+        cons = [{"type": "ineq", "fun": lambda x: (x - cyl.c) @ cyl.a},
+                {"type": "ineq", "fun": lambda x: cyl.h - (x - cyl.c) @ cyl.a}]
+        r = minimize(rho2, centre[k], bounds=list(zip(lo[k], hi[k])), constraints=cons,
+                     method="SLSQP", options={"ftol": 1e-15, "maxiter": 500})
+        if abs(r.fun - cyl.r ** 2) > 1e-7:
+            assert got[k] == (r.fun <= cyl.r ** 2), (k, r.fun)
+            checked += 1
+    assert checked > 500

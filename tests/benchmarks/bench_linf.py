@@ -44,6 +44,7 @@ def main() -> None:
         ("sphere (quadric)", linf.Sphere((0.1, 0.2, 0.3), 1.0), "45-50"),
         ("rotated ellipsoid (quadric)", linf.Ellipsoid((0.1, 0.2, 0.3), (1.2, 0.7, 0.4), q),
          "45-50"),
+        ("rotated capped cylinder", linf.Cylinder((0.1, 0.2, 0.3), q[:, 0], 1.5, 0.5), "-"),
     ]
     print(f"{'query':<30} {'µs/point':>9} {'weighted':>9} {'Varadhan µs':>12}")
     for name, prim, paper in rows:

@@ -1,0 +1,270 @@
+"""Max-norm distance to a capped cylinder in any position, by contact equations (Varadhan §3.2).
+
+The cylinder has base centre ``c``, unit axis ``a``, height ``h`` and radius
+``r``: ``K = {x : 0 <= s <= h, rho <= r}`` with ``y = x - c``, ``s = y.a`` and
+``rho = |y - s a|``. ``K`` is convex; the growing box ``B(p, t)`` is
+axis-aligned in the world.
+
+* Inside: the box is in ``K`` iff its 8 corners are; each corner leaves along
+  its ray at ``min(slab exit, cylinder exit)`` (a linear and a quadratic
+  equation).
+* Outside, the first contact is one of:
+
+  - a box vertex entering ``K`` (the ray's entry: the later of the slab and
+    cylinder entries, if before both exits);
+  - a box edge (a line along ``e_k``) touching the side (its trace on the
+    plane of the other two axes reaches the shadow of the infinite cylinder,
+    a quadratic; the touching point must lie on the edge and between the
+    caps), a cap's rim (the line's crossing with the cap plane enters the cap
+    disk, a quadratic), or a cap's face (a line parallel to the cap plane
+    reaches it: linear; the chord must meet the edge);
+  - a box face touching the support set of ``K``: a rim point, or a side
+    segment (face normal across the axis), or a cap disk (face normal along
+    the axis), which must meet the face.
+
+  The distance is the smallest valid contact time.
+
+Examples
+--------
+>>> import numpy as np
+>>> cyl = Cylinder((0, 0, 0), (0, 0, 1), h=2.0, r=1.0)
+>>> cyl.distance(np.array([[3.0, 0, 1], [0, 0, 1], [0, 0, 4]])).round(12).tolist()
+[2.0, -0.707106781187, 2.0]
+"""
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+import implicitvox as iv
+
+from .ellipsoid import _roots
+from .norm import as_points, as_weights
+
+__all__ = ["Cylinder"]
+
+_SIGNS = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)],
+                  dtype=np.float64)
+_TOL = 1e-12
+
+
+class Cylinder:
+    """Capped cylinder: base centre, axis direction (any length), height, radius."""
+
+    def __init__(self, base: Any, axis: Any, h: float, r: float):
+        self.c = np.asarray(base, dtype=np.float64).reshape(3)
+        a = np.asarray(axis, dtype=np.float64).reshape(3)
+        if not np.linalg.norm(a) > 0:
+            raise ValueError("axis must not be zero")
+        self.a = a / np.linalg.norm(a)
+        self.h, self.r = float(h), float(r)
+        if not (self.h > 0 and self.r > 0):
+            raise ValueError(f"h and r must be positive, got h={h!r}, r={r!r}")
+        self.M = np.eye(3) - np.outer(self.a, self.a)
+
+    @property
+    def expr(self) -> iv.Expr:
+        y = [iv.x - self.c[0], iv.y - self.c[1], iv.z - self.c[2]]
+        s = self.a[0] * y[0] + self.a[1] * y[1] + self.a[2] * y[2]
+        perp = [y[i] - self.a[i] * s for i in range(3)]
+        rho = iv.sqrt(perp[0] ** 2 + perp[1] ** 2 + perp[2] ** 2)
+        return iv.max(rho - self.r, -s, s - self.h)
+
+    @property
+    def bounds(self):
+        ends = np.array([self.c, self.c + self.h * self.a])
+        ext = self.r * np.sqrt(np.maximum(1 - self.a ** 2, 0))
+        return tuple((ends.min(0) - ext).tolist()), tuple((ends.max(0) + ext).tolist())
+
+    # -- pieces ----------------------------------------------------------------------------
+    def _inside(self, y):
+        s = y @ self.a
+        rho2 = np.sum(y * y, axis=1) - s * s
+        return (s >= 0) & (s <= self.h) & (rho2 <= self.r * self.r)
+
+    def _ray(self, y, d):
+        """Entry and exit times of rays ``y + t d`` (NaN if they miss ``K``)."""
+        s0, ds = y @ self.a, d @ self.a
+        with np.errstate(divide="ignore", invalid="ignore"):
+            t_a, t_b = -s0 / ds, (self.h - s0) / ds
+        slab_in = np.where(ds != 0, np.minimum(t_a, t_b), np.where((s0 >= 0) & (s0 <= self.h),
+                                                                   -np.inf, np.nan))
+        slab_out = np.where(ds != 0, np.maximum(t_a, t_b), np.where((s0 >= 0) & (s0 <= self.h),
+                                                                    np.inf, np.nan))
+        yp, dp = y - s0[:, None] * self.a, d - ds[:, None] * self.a
+        A, B = np.sum(dp * dp, axis=1), np.sum(dp * yp, axis=1)
+        C = np.sum(yp * yp, axis=1) - self.r ** 2
+        with np.errstate(divide="ignore", invalid="ignore"):
+            t1, t2 = _roots(np.where(A > 0, A, 1.0), B, C)
+        cyl_in = np.where(A > 0, t1, np.where(C <= 0, -np.inf, np.nan))
+        cyl_out = np.where(A > 0, t2, np.where(C <= 0, np.inf, np.nan))
+        t_in = np.maximum(slab_in, cyl_in)
+        t_out = np.minimum(slab_out, cyl_out)
+        ok = t_in <= t_out
+        return np.where(ok, t_in, np.nan), np.where(ok, t_out, np.nan)
+
+    def distance(self, points: Any, weights: Any = None) -> np.ndarray:
+        p = as_points(points)
+        w = as_weights(weights, len(p))
+        y = p - self.c
+        inside = self._inside(y)
+        out = np.empty(len(p))
+        yi, wi = y[inside], w[inside]
+        depth = np.full(len(yi), np.inf)
+        for s in _SIGNS:
+            _, t_out = self._ray(yi, s * wi)
+            depth = np.fmin(depth, np.maximum(t_out, 0.0))
+        out[inside] = -depth
+        out[~inside] = self._gap(y[~inside], w[~inside])
+        return out
+
+    def _gap(self, y, w):
+        best = np.full(len(y), np.inf)
+        for s in _SIGNS:                                              # vertices
+            t_in, _ = self._ray(y, s * w)
+            best = np.fmin(best, np.where(t_in >= 0, t_in, np.inf))
+        for k in range(3):                                            # edges along e_k
+            i, j = [a for a in range(3) if a != k]
+            for si in (-1.0, 1.0):
+                for sj in (-1.0, 1.0):
+                    best = np.fmin(best, self._edge(y, w, i, j, k, si, sj))
+        for i in range(3):                                            # faces
+            for sigma in (-1.0, 1.0):
+                best = np.fmin(best, self._face(y, w, i, sigma))
+        return best
+
+    def _on_edge(self, yk, y, w, k, t):
+        return np.abs(yk - y[:, k]) <= t * w[:, k] * (1 + _TOL) + _TOL * np.abs(yk)
+
+    def _edge(self, y, w, i, j, k, si, sj):
+        a, M, h, r = self.a, self.M, self.h, self.r
+        n = len(y)
+        z0 = y[:, [i, j]]
+        dz = np.stack([si * w[:, i], sj * w[:, j]], axis=1)
+        best = np.full(n, np.inf)
+        # the side: the line's closest approach to the axis line reaches r
+        if M[k, k] > _TOL:
+            P = M[np.ix_([i, j], [i, j])] - np.outer(M[[i, j], k], M[k, [i, j]]) / M[k, k]
+            Pz0 = z0 @ P
+            A = np.sum((dz @ P) * dz, axis=1)
+            B = np.sum(Pz0 * dz, axis=1)
+            C = np.sum(Pz0 * z0, axis=1) - r * r
+            with np.errstate(divide="ignore", invalid="ignore"):
+                t1, _ = _roots(np.where(A > 0, A, 1.0), B, C)
+                t1 = np.where((A > 0) & (C > 0) & (t1 >= 0), t1,
+                              np.where((A == 0) & (B < 0), -C / (2 * B), np.nan))
+            z = z0 + t1[:, None] * dz
+            yk = -(z @ M[[i, j], k]) / M[k, k]
+            full = np.empty((n, 3))
+            full[:, i], full[:, j], full[:, k] = z[:, 0], z[:, 1], yk
+            s = full @ a
+            ok = (s >= -_TOL * h) & (s <= h * (1 + _TOL)) & self._on_edge(yk, y, w, k, t1)
+            best = np.fmin(best, np.where(ok, t1, np.inf))
+        else:
+            # axis along e_k: the trace reaches the circle; the edge must overlap the slab
+            A = np.sum(dz * dz, axis=1)
+            B = np.sum(z0 * dz, axis=1)
+            C = np.sum(z0 * z0, axis=1) - r * r
+            t1, _ = _roots(A, B, C)
+            t1 = np.where((C > 0) & (t1 >= 0), t1, np.nan)
+            lo_k, hi_k = sorted((0.0, h * a[k]))
+            ok = (y[:, k] - t1 * w[:, k] <= hi_k * (1 + _TOL) + _TOL) & \
+                (y[:, k] + t1 * w[:, k] >= lo_k - _TOL * (1 + abs(lo_k)))
+            best = np.fmin(best, np.where(ok, t1, np.inf))
+        # the caps
+        for s_cap in (0.0, h):
+            if abs(a[k]) > _TOL:
+                # the line crosses the cap plane at y_k = (s_cap - a_i z_i - a_j z_j) / a_k
+                def point(t):
+                    z = z0 + t[:, None] * dz
+                    yk = (s_cap - z @ a[[i, j]]) / a[k]
+                    return z, yk
+                zc0, ykc0 = point(np.zeros(n))
+                dyk = -(dz @ a[[i, j]]) / a[k]
+                q0 = np.zeros((n, 3))
+                q0[:, i], q0[:, j], q0[:, k] = zc0[:, 0], zc0[:, 1], ykc0
+                dq = np.zeros((n, 3))
+                dq[:, i], dq[:, j], dq[:, k] = dz[:, 0], dz[:, 1], dyk
+                q0p = q0 - s_cap * a                 # relative to the cap centre (in-plane)
+                A = np.sum(dq * dq, axis=1)
+                B = np.sum(q0p * dq, axis=1)
+                C = np.sum(q0p * q0p, axis=1) - r * r
+                with np.errstate(divide="ignore", invalid="ignore"):
+                    t1, _ = _roots(np.where(A > 0, A, 1.0), B, C)
+                t1 = np.where((A > 0) & (C > 0) & (t1 >= 0), t1, np.nan)
+                _, yk = point(np.nan_to_num(t1))
+                ok = self._on_edge(yk, y, w, k, t1)
+                best = np.fmin(best, np.where(ok, t1, np.inf))
+            else:
+                # the line is parallel to the cap plane: it reaches the plane at one time
+                ds = dz @ a[[i, j]]
+                s0 = z0 @ a[[i, j]]
+                with np.errstate(divide="ignore", invalid="ignore"):
+                    t1 = (s_cap - s0) / ds
+                t1 = np.where((ds != 0) & (t1 >= 0), t1, np.nan)
+                z = z0 + t1[:, None] * dz
+                # the line's chord through the disk: its points y_k with |y - s_cap a| <= r
+                q = np.zeros((n, 3))
+                q[:, i], q[:, j] = z[:, 0], z[:, 1]
+                qp = q - s_cap * a                   # in-plane offset, but for the k part
+                # |qp + y_k e_k|^2 <= r^2, a quadratic in y_k (e_k lies in the cap plane)
+                Bk, Ck = qp[:, k], np.sum(qp * qp, axis=1) - r * r
+                disc = Bk * Bk - Ck
+                with np.errstate(invalid="ignore"):
+                    root = np.sqrt(disc)
+                chord_lo, chord_hi = -Bk - root, -Bk + root
+                ok = (disc >= 0) & (chord_lo <= y[:, k] + t1 * w[:, k] * (1 + _TOL)) & \
+                    (chord_hi >= y[:, k] - t1 * w[:, k] * (1 + _TOL))
+                best = np.fmin(best, np.where(ok, t1, np.inf))
+        return best
+
+    def _face(self, y, w, i, sigma):
+        """The face with outward normal ``sigma e_i`` against K's support set there."""
+        a, h, r = self.a, self.h, self.r
+        u = np.zeros(3)
+        u[i] = -sigma                                 # K's extreme point toward the box
+        others = [b for b in range(3) if b != i]
+        au = a @ u
+        perp = u - au * a
+        pn = np.linalg.norm(perp)
+        ends = []
+        if au > _TOL:
+            ends = [h]
+        elif au < -_TOL:
+            ends = [0.0]
+        else:
+            ends = [0.0, h]                           # a side segment
+        if pn > _TOL:
+            rim = r * perp / pn
+            pts = [s * a + rim for s in ends]
+            x_i = pts[0][i]
+            t = sigma * (x_i - y[:, i]) / w[:, i]
+            if len(pts) == 1:
+                ok = (t >= 0) & np.all(np.abs(pts[0][others] - y[:, others])
+                                       <= t[:, None] * w[:, others] * (1 + _TOL) + _TOL, axis=1)
+            else:                                     # segment pts[0] -> pts[1] meets the face?
+                lo_s, hi_s = np.zeros(len(y)), np.ones(len(y))
+                d = pts[1] - pts[0]
+                for b in others:
+                    lo_b = y[:, b] - t * w[:, b] * (1 + _TOL) - _TOL
+                    hi_b = y[:, b] + t * w[:, b] * (1 + _TOL) + _TOL
+                    if abs(d[b]) > 0:
+                        s1, s2 = (lo_b - pts[0][b]) / d[b], (hi_b - pts[0][b]) / d[b]
+                        lo_s = np.maximum(lo_s, np.minimum(s1, s2))
+                        hi_s = np.minimum(hi_s, np.maximum(s1, s2))
+                    else:
+                        inside = (pts[0][b] >= lo_b) & (pts[0][b] <= hi_b)
+                        hi_s = np.where(inside, hi_s, -1.0)
+                ok = (t >= 0) & (lo_s <= hi_s)
+            return np.where(ok, t, np.inf)
+        # the axis is along e_i: the support set is a cap disk in the plane x_i = const
+        centre = ends[0] * a
+        t = sigma * (centre[i] - y[:, i]) / w[:, i]
+        gap = np.maximum(np.abs(centre[others] - y[:, others]) - t[:, None] * w[:, others], 0)
+        ok = (t >= 0) & (np.sqrt(np.sum(gap * gap, axis=1)) <= r * (1 + _TOL))
+        return np.where(ok, t, np.inf)
+
+    def classify_boxes(self, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+        from .classify import classify_by_distance
+        return classify_by_distance(self.distance, lo, hi)
