@@ -10,7 +10,7 @@ leaf classifies boxes as EMPTY, FULL or AMBIGUOUS:
   (:class:`implicitvox.tribox.Triangles`), else FULL or EMPTY by the winding
   number at the box's centre;
 * boxes, convex polyhedra, half-spaces, spheres and ellipsoids (under any
-  affine map) and capped cylinders (under similarities) by their max-norm
+  affine map), capped cylinders and cones (under similarities) by their max-norm
   distance (Varadhan §5.1, :mod:`implicitvox.linf`): AMBIGUOUS iff the
   surface meets the box (up to rounding at exact ties);
 * a function by its interval enclosure (sound; AMBIGUOUS may be a near miss).
@@ -70,14 +70,14 @@ def _linf_leaf(solid, matrix: np.ndarray):
         return linf.Ellipsoid.from_affine(m * solid.r, m @ solid.center + t)
     if isinstance(solid, Ellipsoid):
         return linf.Ellipsoid.from_affine(m @ np.diag(solid.radii), m @ solid.center + t)
-    if isinstance(solid, Cylinder) and solid.r1 == solid.r2:
+    if isinstance(solid, Cylinder):
         gram = m.T @ m
         scale2 = gram[0, 0]
         if np.allclose(gram, scale2 * np.eye(3), rtol=0, atol=1e-12 * scale2):   # similarity
             z0, _ = solid._z
             k = np.sqrt(scale2)
-            return linf.Cylinder(m @ np.array([0.0, 0.0, z0]) + t, m[:, 2], solid.h * k,
-                                 solid.r1 * k)
+            return linf.Frustum(m @ np.array([0.0, 0.0, z0]) + t, m[:, 2], solid.h * k,
+                                solid.r1 * k, solid.r2 * k)
     return None
 
 

@@ -8,14 +8,13 @@ the surface meets the closed box - exactly, up to rounding at ties
 
 * :class:`HalfSpace`, :class:`ConvexPolytope` (boxes, oriented boxes, any
   bounded intersection of half-spaces or convex hull) - §3.1.1, §3.1.2;
-* :class:`Sphere`, :class:`Ellipsoid` and the capped :class:`Cylinder` (any
-  rigid motion) - §3.2 (contact equations: vertex, edge and face contacts of
-  the box);
+* :class:`Sphere`, :class:`Ellipsoid`, the capped :class:`Cylinder` and the
+  cone or :class:`Frustum` (any rigid motion) - §3.2 (contact equations:
+  vertex, edge and face contacts of the box);
 * :func:`triangle_distance` and :class:`TriangleMesh` (culling by upper and
   lower bounds) - §3.3, §4.1.
 
-Not yet here: general (non-ellipsoidal) quadrics, cones and frustums, the
-torus.
+Not yet here: general (non-ellipsoidal) quadrics and the torus.
 
 Examples
 --------
@@ -35,9 +34,9 @@ from .mesh import TriangleMesh
 from .polytope import ConvexPolytope, HalfSpace, triangle_distance
 from .sphere import Sphere
 from .ellipsoid import Ellipsoid
-from .cylinder import Cylinder
+from .cylinder import Cylinder, Frustum
 
-__all__ = ["linf_distance", "HalfSpace", "ConvexPolytope", "Sphere", "Ellipsoid", "Cylinder",
+__all__ = ["linf_distance", "HalfSpace", "ConvexPolytope", "Sphere", "Ellipsoid", "Cylinder", "Frustum",
            "TriangleMesh",
            "triangle_distance", "classify_by_distance"]
 
@@ -49,11 +48,11 @@ def linf_distance(shape: Any, points: Any, weights: Any = None) -> np.ndarray:
     ``linf_distance(points, weights)`` method (as :mod:`csg` solids with
     exact leaves have).
     """
-    if isinstance(shape, (HalfSpace, ConvexPolytope, Sphere, Ellipsoid, Cylinder, TriangleMesh)):
+    if isinstance(shape, (HalfSpace, ConvexPolytope, Sphere, Ellipsoid, Frustum, TriangleMesh)):
         return shape.distance(points, weights)
     method = getattr(shape, "linf_distance", None)
     if callable(method):
         return method(points, weights)
     raise TypeError(f"no max-norm distance for {type(shape).__name__}: use a primitive of "
                     "implicitvox.linf (HalfSpace, ConvexPolytope, Sphere, Ellipsoid, Cylinder, "
-                    "TriangleMesh)")
+                    "Frustum, TriangleMesh)")

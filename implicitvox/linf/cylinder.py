@@ -42,26 +42,37 @@ import implicitvox as iv
 from .ellipsoid import _roots
 from .norm import as_points, as_weights
 
-__all__ = ["Cylinder"]
+__all__ = ["Cylinder", "Frustum"]
 
 _SIGNS = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)],
                   dtype=np.float64)
 _TOL = 1e-12
 
 
-class Cylinder:
-    """Capped cylinder: base centre, axis direction (any length), height, radius."""
+class Frustum:
+    """Capped cone or frustum: base centre, axis direction (any length), height, radius
+    ``r1`` at the base and ``r2`` at the top (one of them may be 0: a cone)."""
 
-    def __init__(self, base: Any, axis: Any, h: float, r: float):
+    def __init__(self, base: Any, axis: Any, h: float, r1: float, r2: float):
         self.c = np.asarray(base, dtype=np.float64).reshape(3)
         a = np.asarray(axis, dtype=np.float64).reshape(3)
         if not np.linalg.norm(a) > 0:
             raise ValueError("axis must not be zero")
         self.a = a / np.linalg.norm(a)
-        self.h, self.r = float(h), float(r)
-        if not (self.h > 0 and self.r > 0):
-            raise ValueError(f"h and r must be positive, got h={h!r}, r={r!r}")
+        self.h, self.r1, self.r2 = float(h), float(r1), float(r2)
+        if not (self.h > 0 and self.r1 >= 0 and self.r2 >= 0 and max(r1, r2) > 0):
+            raise ValueError(f"h must be positive and the radii >= 0 (not both 0), got "
+                             f"h={h!r}, r1={r1!r}, r2={r2!r}")
+        self.k = (self.r2 - self.r1) / self.h             # radius slope along the axis
+        self.r = max(self.r1, self.r2)
         self.M = np.eye(3) - np.outer(self.a, self.a)
+        # rho^2 - R(s)^2 = y^T G y + 2 g.y + c0
+        self.G = self.M - self.k ** 2 * np.outer(self.a, self.a)
+        self.g = -self.r1 * self.k * self.a
+        self.c0 = -self.r1 ** 2
+
+    def radius(self, s: Any) -> Any:
+        return self.r1 + self.k * s
 
     @property
     def expr(self) -> iv.Expr:
@@ -69,7 +80,8 @@ class Cylinder:
         s = self.a[0] * y[0] + self.a[1] * y[1] + self.a[2] * y[2]
         perp = [y[i] - self.a[i] * s for i in range(3)]
         rho = iv.sqrt(perp[0] ** 2 + perp[1] ** 2 + perp[2] ** 2)
-        return iv.max(rho - self.r, -s, s - self.h)
+        side = (rho - (self.r1 + self.k * s)) / float(np.hypot(1.0, self.k))
+        return iv.max(side, -s, s - self.h)
 
     @property
     def bounds(self):
@@ -80,8 +92,9 @@ class Cylinder:
     # -- pieces ----------------------------------------------------------------------------
     def _inside(self, y):
         s = y @ self.a
-        rho2 = np.sum(y * y, axis=1) - s * s
-        return (s >= 0) & (s <= self.h) & (rho2 <= self.r * self.r)
+        perp = y - s[:, None] * self.a             # |y|^2 - s^2 would cancel near the axis
+        rho2 = np.sum(perp * perp, axis=1)
+        return (s >= 0) & (s <= self.h) & (rho2 <= self.radius(s) ** 2)
 
     def _ray(self, y, d):
         """Entry and exit times of rays ``y + t d`` (NaN if they miss ``K``)."""
@@ -92,17 +105,35 @@ class Cylinder:
                                                                    -np.inf, np.nan))
         slab_out = np.where(ds != 0, np.maximum(t_a, t_b), np.where((s0 >= 0) & (s0 <= self.h),
                                                                     np.inf, np.nan))
-        yp, dp = y - s0[:, None] * self.a, d - ds[:, None] * self.a
-        A, B = np.sum(dp * dp, axis=1), np.sum(dp * yp, axis=1)
-        C = np.sum(yp * yp, axis=1) - self.r ** 2
+        # rho^2 - R^2 <= 0 along the ray: A t^2 + 2 B t + C <= 0
+        Gd = d @ self.G
+        A = np.sum(Gd * d, axis=1)
+        B = np.sum(Gd * y, axis=1) + d @ self.g
+        C = np.sum((y @ self.G) * y, axis=1) + 2 * (y @ self.g) + self.c0
         with np.errstate(divide="ignore", invalid="ignore"):
-            t1, t2 = _roots(np.where(A > 0, A, 1.0), B, C)
-        cyl_in = np.where(A > 0, t1, np.where(C <= 0, -np.inf, np.nan))
-        cyl_out = np.where(A > 0, t2, np.where(C <= 0, np.inf, np.nan))
-        t_in = np.maximum(slab_in, cyl_in)
-        t_out = np.minimum(slab_out, cyl_out)
-        ok = t_in <= t_out
-        return np.where(ok, t_in, np.nan), np.where(ok, t_out, np.nan)
+            t1, t2 = _roots(np.where(A != 0, A, 1.0), B, C)
+            lin = -C / (2 * B)
+        real = ~np.isnan(t1)
+        inf = np.full_like(t1, np.inf)
+        # the (at most two) intervals where the quadric is <= 0; within the slab only one
+        # of them belongs to the real cone (the other nappe has R < 0)
+        lo1 = np.where(A > 0, np.where(real, t1, np.nan),
+                       np.where(A < 0, -inf, np.where(B > 0, -inf, np.where(
+                           B < 0, lin, np.where(C <= 0, -inf, np.nan)))))
+        hi1 = np.where(A > 0, np.where(real, t2, np.nan),
+                       np.where(A < 0, np.where(real, t1, inf), np.where(
+                           B > 0, lin, np.where(B < 0, inf, np.where(C <= 0, inf, np.nan)))))
+        lo2 = np.where((A < 0) & real, t2, np.nan)
+        hi2 = np.where((A < 0) & real, inf, np.nan)
+        t_in = np.full_like(t1, np.nan)
+        t_out = np.full_like(t1, np.nan)
+        for lo_q, hi_q in ((lo1, hi1), (lo2, hi2)):
+            a_in = np.maximum(slab_in, lo_q)
+            a_out = np.minimum(slab_out, hi_q)
+            ok = (a_in <= a_out) & np.isnan(t_in)
+            t_in = np.where(ok, a_in, t_in)
+            t_out = np.where(ok, a_out, t_out)
+        return t_in, t_out
 
     def distance(self, points: Any, weights: Any = None) -> np.ndarray:
         p = as_points(points)
@@ -138,29 +169,38 @@ class Cylinder:
         return np.abs(yk - y[:, k]) <= t * w[:, k] * (1 + _TOL) + _TOL * np.abs(yk)
 
     def _edge(self, y, w, i, j, k, si, sj):
-        a, M, h, r = self.a, self.M, self.h, self.r
+        a, M, h, r = self.a, self.M, self.h, self.r1
         n = len(y)
         z0 = y[:, [i, j]]
         dz = np.stack([si * w[:, i], sj * w[:, j]], axis=1)
         best = np.full(n, np.inf)
-        # the side: the line's closest approach to the axis line reaches r
-        if M[k, k] > _TOL:
-            P = M[np.ix_([i, j], [i, j])] - np.outer(M[[i, j], k], M[k, [i, j]]) / M[k, k]
+        # the side: the line touches rho = R(s) where rho^2 - R^2, minimised along it, is 0
+        G, gv, Gkk = self.G, self.g, self.G[k, k]
+        if Gkk > _TOL:
+            zi = [i, j]
+            P = G[np.ix_(zi, zi)] - np.outer(G[zi, k], G[k, zi]) / Gkk
+            lv = gv[zi] - G[zi, k] * gv[k] / Gkk
+            c1 = self.c0 - gv[k] ** 2 / Gkk
             Pz0 = z0 @ P
             A = np.sum((dz @ P) * dz, axis=1)
-            B = np.sum(Pz0 * dz, axis=1)
-            C = np.sum(Pz0 * z0, axis=1) - r * r
+            B = np.sum(Pz0 * dz, axis=1) + dz @ lv
+            C = np.sum(Pz0 * z0, axis=1) + 2 * (z0 @ lv) + c1
+            # every time the line is tangent to the (double) quadric is a candidate: a
+            # tangency on the real cone, at a point of the edge, is a genuine contact
             with np.errstate(divide="ignore", invalid="ignore"):
-                t1, _ = _roots(np.where(A > 0, A, 1.0), B, C)
-                t1 = np.where((A > 0) & (C > 0) & (t1 >= 0), t1,
-                              np.where((A == 0) & (B < 0), -C / (2 * B), np.nan))
-            z = z0 + t1[:, None] * dz
-            yk = -(z @ M[[i, j], k]) / M[k, k]
-            full = np.empty((n, 3))
-            full[:, i], full[:, j], full[:, k] = z[:, 0], z[:, 1], yk
-            s = full @ a
-            ok = (s >= -_TOL * h) & (s <= h * (1 + _TOL)) & self._on_edge(yk, y, w, k, t1)
-            best = np.fmin(best, np.where(ok, t1, np.inf))
+                r1, r2 = _roots(np.where(A != 0, A, 1.0), B, C)
+                lin = np.where(B != 0, -C / (2 * B), np.nan)
+            for t1 in (np.where(A != 0, r1, lin), np.where(A != 0, r2, np.nan)):
+                t1 = np.where(t1 >= 0, t1, np.nan)
+                z = z0 + t1[:, None] * dz
+                yk = -(z @ G[zi, k] + gv[k]) / Gkk
+                full = np.empty((n, 3))
+                full[:, i], full[:, j], full[:, k] = z[:, 0], z[:, 1], yk
+                s = full @ a
+                ok = (s >= -_TOL * h) & (s <= h * (1 + _TOL)) & self._on_edge(yk, y, w, k, t1)
+                best = np.fmin(best, np.where(ok, t1, np.inf))
+        elif self.k != 0:
+            pass        # a line steeper than the cone crosses its side: contacts are at rims
         else:
             # axis along e_k: the trace reaches the circle; the edge must overlap the slab
             A = np.sum(dz * dz, axis=1)
@@ -173,7 +213,9 @@ class Cylinder:
                 (y[:, k] + t1 * w[:, k] >= lo_k - _TOL * (1 + abs(lo_k)))
             best = np.fmin(best, np.where(ok, t1, np.inf))
         # the caps
-        for s_cap in (0.0, h):
+        for s_cap, r in ((0.0, self.r1), (h, self.r2)):
+            if r == 0:
+                continue                      # an apex: met by a face or a vertex first
             if abs(a[k]) > _TOL:
                 # the line crosses the cap plane at y_k = (s_cap - a_i z_i - a_j z_j) / a_k
                 def point(t):
@@ -221,23 +263,24 @@ class Cylinder:
 
     def _face(self, y, w, i, sigma):
         """The face with outward normal ``sigma e_i`` against K's support set there."""
-        a, h, r = self.a, self.h, self.r
+        a, h = self.a, self.h
         u = np.zeros(3)
         u[i] = -sigma                                 # K's extreme point toward the box
         others = [b for b in range(3) if b != i]
         au = a @ u
         perp = u - au * a
         pn = np.linalg.norm(perp)
-        ends = []
-        if au > _TOL:
+        # the support value of each cap's rim; equal: a side segment (a generatrix)
+        v0, vh = self.r1 * pn, h * au + self.r2 * pn
+        if vh > v0 + _TOL * (abs(v0) + abs(vh) + h):
             ends = [h]
-        elif au < -_TOL:
+        elif v0 > vh + _TOL * (abs(v0) + abs(vh) + h):
             ends = [0.0]
         else:
-            ends = [0.0, h]                           # a side segment
+            ends = [0.0, h]
         if pn > _TOL:
-            rim = r * perp / pn
-            pts = [s * a + rim for s in ends]
+            dirn = perp / pn
+            pts = [s * a + self.radius(s) * dirn for s in ends]
             x_i = pts[0][i]
             t = sigma * (x_i - y[:, i]) / w[:, i]
             if len(pts) == 1:
@@ -260,6 +303,7 @@ class Cylinder:
             return np.where(ok, t, np.inf)
         # the axis is along e_i: the support set is a cap disk in the plane x_i = const
         centre = ends[0] * a
+        r = self.radius(ends[0])
         t = sigma * (centre[i] - y[:, i]) / w[:, i]
         gap = np.maximum(np.abs(centre[others] - y[:, others]) - t[:, None] * w[:, others], 0)
         ok = (t >= 0) & (np.sqrt(np.sum(gap * gap, axis=1)) <= r * (1 + _TOL))
@@ -268,3 +312,12 @@ class Cylinder:
     def classify_boxes(self, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
         from .classify import classify_by_distance
         return classify_by_distance(self.distance, lo, hi)
+
+
+class Cylinder(Frustum):
+    """Capped cylinder: base centre, axis direction (any length), height, radius."""
+
+    def __init__(self, base: Any, axis: Any, h: float, r: float):
+        if not float(r) > 0:
+            raise ValueError(f"h and r must be positive, got h={h!r}, r={r!r}")
+        super().__init__(base, axis, h, r, r)
