@@ -284,7 +284,7 @@ def test_cylinder_matches_a_convex_programme(name):
     axis, r1, r2 = CYLINDERS[name]
     a = _rotation(rng)[:, 0] if axis is None else axis
     cyl = linf.Frustum((0.1, 0.2, -0.3), a, 1.2, r1, r2)
-    n = 150
+    n = 80
     p = rng.normal(size=(n, 3)) * 1.2
     p[:20] = cyl.c + rng.uniform(-0.5, 1.7, (20, 1)) * cyl.a     # on the axis line
     w = rng.uniform(0.5, 2, (n, 3))
@@ -306,6 +306,12 @@ def test_cylinder_matches_a_convex_programme(name):
                                 float(np.max(np.abs(r.x[:3] - p[i]) - r.x[3] * w[i])))
                 if violation < 1e-8 and r.x[3] < best:
                     best, slack = r.x[3], violation
+            for s_end, rad in ((0.0, cyl.r1), (cyl.h, cyl.r2)):
+                if rad == 0:             # an apex is a point of K: its distance bounds too
+                    apex = cyl.c + s_end * cyl.a
+                    t_apex = float(np.max(np.abs(apex - p[i]) / w[i]))
+                    if t_apex < best:
+                        best, slack = t_apex, 0.0
             # the brute force is as exact as its end point is feasible: allow for that
             assert d[i] == pytest.approx(best, rel=1e-9, abs=1e-12 + 100 * slack), (i, p[i])
             continue
