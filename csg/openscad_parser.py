@@ -32,8 +32,9 @@ from typing import Any, Optional
 
 __all__ = ["OpenSCADError", "Node", "parse", "tokenize", "MAX_DEPTH", "MAX_TOKENS"]
 
-#: nesting depth limit (modules and vectors)
-MAX_DEPTH = 500
+#: nesting depth limit (modules and vectors); the parser recurses, so this stays well
+#: inside Python's recursion limit
+MAX_DEPTH = 200
 #: token limit (a 100 MB file); larger input is refused
 MAX_TOKENS = 20_000_000
 
@@ -243,4 +244,9 @@ def parse(text: str, source: str = "<csg>") -> list[Node]:
     if not isinstance(text, str):
         raise TypeError(f"text must be str, got {type(text).__name__}")
     parser = _Parser(tokenize(text, source), source)
-    return parser.statements(0, None)
+    try:
+        return parser.statements(0, None)
+    except RecursionError:     # a deep stack beneath us: refuse rather than crash
+        t = parser.tok
+        raise OpenSCADError("nesting too deep for the parser", t.line, t.column, source) \
+            from None

@@ -59,7 +59,7 @@ from .solid import (Complement, Difference, ExprSolid, Intersection, Solid, Tran
 __all__ = ["to_json", "load_json", "to_dict", "from_dict", "SceneError", "LIMITS"]
 
 #: hostile-input limits
-LIMITS = {"text_bytes": 200 << 20, "depth": 200, "nodes": 100_000, "array": 5_000_000,
+LIMITS = {"text_bytes": 200 << 20, "depth": 100, "nodes": 100_000, "array": 5_000_000,
           "expr_chars": 1 << 20}
 
 
@@ -167,7 +167,10 @@ def _no_constant(name: str):
 
 def from_dict(node: Any, path: str = "root") -> Solid:
     """The solid of a scene node (see the module docstring)."""
-    return _Reader().read(node, path, 0)
+    try:
+        return _Reader().read(node, path, 0)
+    except RecursionError:      # a deep stack beneath us: refuse rather than crash
+        raise SceneError(f"{path}: nested too deeply for the reader") from None
 
 
 class _Reader:

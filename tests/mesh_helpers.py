@@ -7,8 +7,21 @@ import numpy as np
 
 from tests.clip_oracle import triangle_meets_box
 
-#: the Stanford bunny in the workspace's shared data (not redistributed with the repository)
-BUNNY = Path(__file__).resolve().parents[2] / "shared" / "data" / "meshes" / "stanford-bunny.obj"
+def _find_bunny() -> Path:
+    """The Stanford bunny in the workspace's shared data (not redistributed with the
+    repository): ``$IMPLICITVOX_BUNNY``, else ``../shared`` beside the checkout, else
+    ``/work/shared``."""
+    import os
+    rel = Path("shared") / "data" / "meshes" / "stanford-bunny.obj"
+    for cand in (os.environ.get("IMPLICITVOX_BUNNY"), Path(__file__).resolve().parents[2] / rel,
+                 Path("/work") / rel):
+        if cand and Path(cand).exists():
+            return Path(cand)
+    return Path(__file__).resolve().parents[2] / rel
+
+
+#: the Stanford bunny (see :func:`_find_bunny`)
+BUNNY = _find_bunny()
 
 
 def sample_surface(tri: np.ndarray, n: int, rng: np.random.Generator) -> np.ndarray:

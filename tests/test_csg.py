@@ -170,7 +170,7 @@ def test_json_round_trip_exact():
 
 HOSTILE = [
     ('{"implicitvox_scene": 1, "root": ' + '{"type": "complement", "child": ' * 300
-     + '{"type": "sphere", "r": 1}' + "}" * 301, "nested deeper"),
+     + '{"type": "sphere", "r": 1}' + "}" * 301, "nested deeper|nested too deeply"),
     ('[' * 100000 + ']' * 100000, "nested too deeply|a scene is"),
     ('{"implicitvox_scene": 1, "root": {"type": "polyhedron", "vertices": [' +
      ",".join(["[0,0,0]"] * 2_000_000) + '], "faces": [[0,1,2]]}}', "more than"),

@@ -18,7 +18,10 @@ import numpy as np
 from implicitvox import linf
 from implicitvox.mesh_input import as_triangles
 
-BUNNY = Path(__file__).resolve().parents[3] / "shared" / "data" / "meshes" / "stanford-bunny.obj"
+BUNNY = next((p for p in (Path(__file__).resolve().parents[3] / "shared" / "data" / "meshes"
+                          / "stanford-bunny.obj",
+                          Path("/work/shared/data/meshes/stanford-bunny.obj")) if p.exists()),
+             Path("/work/shared/data/meshes/stanford-bunny.obj"))
 N = 100_000
 
 

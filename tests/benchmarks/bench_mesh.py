@@ -24,7 +24,10 @@ import numpy as np
 import implicitvox as ivx
 from implicitvox.mesh_input import as_triangles
 
-BUNNY = Path(__file__).resolve().parents[3] / "shared" / "data" / "meshes" / "stanford-bunny.obj"
+BUNNY = next((p for p in (Path(__file__).resolve().parents[3] / "shared" / "data" / "meshes"
+                          / "stanford-bunny.obj",
+                          Path("/work/shared/data/meshes/stanford-bunny.obj")) if p.exists()),
+             Path("/work/shared/data/meshes/stanford-bunny.obj"))
 
 
 def sample_surface(tri: np.ndarray, n: int, rng: np.random.Generator) -> np.ndarray:
