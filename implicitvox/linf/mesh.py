@@ -4,10 +4,10 @@ For each query point:
 
 1. an upper bound: the exact distance to the triangles whose centroids are
    nearest in the max-norm (a k-d tree, :class:`scipy.spatial.cKDTree`);
-2. culling: only triangles whose bounding box lies within that bound (their
-   lower bound, the distance to the box, does not exceed it) can be
-   nearer - a ball query of the tree of box centres, widened by the largest
-   box half-size;
+2. culling (§4.1): a bounding volume hierarchy (triangles in Morton order,
+   leaves of 2, boxes merged pairwise level by level) is walked from the
+   root for all points at once; a (point, node) pair survives only if the
+   node's box - a lower bound - is no farther than the upper bound;
 3. the exact distance to each surviving triangle
    (:func:`~implicitvox.linf.polytope.triangle_distance`), and the minimum.
 
@@ -26,7 +26,6 @@ Examples
 """
 from __future__ import annotations
 
-from itertools import chain
 from typing import Any
 
 import numpy as np
@@ -36,9 +35,9 @@ from .polytope import triangle_distance
 
 __all__ = ["TriangleMesh"]
 
-_NEAREST = 8          # centroids whose triangles set the upper bound
+_NEAREST = 2          # centroids whose triangles set the upper bound
 _BLOCK = 1 << 15      # points per block
-_CLASSES = 4          # triangle size classes
+_LEAF = 2             # triangles per leaf of the hierarchy
 
 
 class TriangleMesh:
@@ -52,24 +51,37 @@ class TriangleMesh:
         if not len(f):
             raise ValueError("the mesh has no triangles")
         self.tri = v[f]
-        lo, hi = self.tri.min(axis=1), self.tri.max(axis=1)
-        centre, half = 0.5 * (lo + hi), (0.5 * (hi - lo)).max(axis=1)
         self.centroids = self.tri.mean(axis=1)
         self.tree = cKDTree(self.centroids)
-        # triangles in size classes, each with its own tree and widening (a big
-        # triangle must not widen the search for all the small ones)
-        edges = np.quantile(half, np.linspace(0, 1, _CLASSES + 1))
-        cls = np.clip(np.searchsorted(edges, half, side="right") - 1, 0, _CLASSES - 1)
-        self.classes = []
-        for c in range(_CLASSES):
-            members = np.flatnonzero(cls == c)
-            if len(members):
-                self.classes.append((members, cKDTree(centre[members]),
-                                     float(half[members].max())))
+        self._build_bvh()
         edges = np.sort(np.concatenate([f[:, [0, 1]], f[:, [1, 2]], f[:, [2, 0]]]), axis=1)
         _, counts = np.unique(edges, axis=0, return_counts=True)
         self.closed = bool(np.all(counts == 2))
         self._winding = None
+
+    def _build_bvh(self) -> None:
+        """A bounding volume hierarchy in arrays: triangles in Morton order of their
+        centroids, leaves of ``_LEAF`` consecutive triangles, each level's boxes the
+        union of two boxes of the level below (a complete binary tree)."""
+        from implicitvox import morton
+        c = self.centroids
+        lo, hi = c.min(axis=0), c.max(axis=0)
+        q = ((c - lo) / np.where(hi > lo, hi - lo, 1.0) * ((1 << 20) - 1)).astype(np.int64)
+        self.order = np.argsort(morton.encode(q), kind="stable")
+        tri = self.tri[self.order]
+        n_leaves = -(-len(tri) // _LEAF)
+        pad = n_leaves * _LEAF - len(tri)
+        tlo = np.concatenate([tri.min(axis=1), np.full((pad, 3), np.inf)])
+        thi = np.concatenate([tri.max(axis=1), np.full((pad, 3), -np.inf)])
+        levels = [(tlo.reshape(n_leaves, _LEAF, 3).min(axis=1),
+                   thi.reshape(n_leaves, _LEAF, 3).max(axis=1))]
+        while len(levels[-1][0]) > 1:
+            blo, bhi = levels[-1]
+            if len(blo) % 2:
+                blo = np.concatenate([blo, np.full((1, 3), np.inf)])
+                bhi = np.concatenate([bhi, np.full((1, 3), -np.inf)])
+            levels.append((np.minimum(blo[0::2], blo[1::2]), np.maximum(bhi[0::2], bhi[1::2])))
+        self.levels = levels[::-1]                       # root first
 
     def distance(self, points: Any, weights: Any = None) -> np.ndarray:
         """Weighted max-norm distance (negative inside a closed mesh)."""
@@ -93,27 +105,35 @@ class TriangleMesh:
         rows = np.repeat(np.arange(len(p)), k)
         d = triangle_distance(p[rows], self.tri[near.ravel()], w[rows]).reshape(len(p), k)
         upper = d.min(axis=1)
-        # any triangle nearer than `upper` (weighted) lies within upper * max(w) (plain)
-        reach = upper * w.max(axis=1) * (1 + 1e-12)
-        cands, owners = [], []
-        for members, tree, half in self.classes:
-            lists = tree.query_ball_point(p, reach + half, p=np.inf, return_sorted=False)
-            counts = np.fromiter(map(len, lists), dtype=np.int64, count=len(lists))
-            flat = np.fromiter(chain.from_iterable(lists), dtype=np.int64,
-                               count=int(counts.sum()))
-            cands.append(members[flat])
-            owners.append(np.repeat(np.arange(len(p)), counts))
-        cand, owner = np.concatenate(cands), np.concatenate(owners)
-        # cull by the lower bound: the distance to the triangle's box
+        # Varadhan §4.1: walk the hierarchy from the root, keeping (point, node) pairs
+        # whose box is no farther than the point's upper bound (the lower bound culls)
+        pt = np.arange(len(p))
+        node = np.zeros(len(p), dtype=np.int64)
+        for depth in range(1, len(self.levels)):
+            blo, bhi = self.levels[depth]
+            pt = np.repeat(pt, 2)
+            node = (2 * np.repeat(node, 2)) + np.tile([0, 1], len(node))
+            ok = node < len(blo)
+            pt, node = pt[ok], node[ok]
+            q, ww = p[pt], w[pt]
+            gap = np.max(np.maximum(np.maximum(blo[node] - q, q - bhi[node]), 0) / ww, axis=1)
+            keep = gap <= upper[pt]
+            pt, node = pt[keep], node[keep]
+        # the leaves' triangles, exactly
+        pt = np.repeat(pt, _LEAF)
+        idx = (np.repeat(node, _LEAF) * _LEAF) + np.tile(np.arange(_LEAF), len(node))
+        ok = idx < len(self.tri)
+        pt, idx = pt[ok], idx[ok]
+        cand = self.order[idx]
         lo = self.tri[cand].min(axis=1)
         hi = self.tri[cand].max(axis=1)
-        q, ww = p[owner], w[owner]
+        q, ww = p[pt], w[pt]
         gap = np.max(np.maximum(np.maximum(lo - q, q - hi), 0) / ww, axis=1)
-        keep = gap <= upper[owner]
-        cand, owner = cand[keep], owner[keep]
-        dist = triangle_distance(p[owner], self.tri[cand], w[owner])
+        keep = gap <= upper[pt]
+        pt, cand = pt[keep], cand[keep]
+        dist = triangle_distance(p[pt], self.tri[cand], w[pt])
         best = upper.copy()
-        np.minimum.at(best, owner, dist)
+        np.minimum.at(best, pt, dist)
         return best
 
     @property
