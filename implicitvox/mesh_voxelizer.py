@@ -31,7 +31,7 @@ from .mesh_solid import BYTES_PER_VOXEL, interior_octants
 from .mesh_subdivide import surface_codes
 from .octree import Octree
 from .tribox import Triangles
-from .voxelizer import _default_budget
+from .voxelizer import memory_budget
 from .voxels import Voxels
 
 __all__ = ["voxelize_mesh", "default_mesh_bounds", "MeshSource"]
@@ -136,12 +136,9 @@ def voxelize_mesh(mesh: Any, resolution: Union[int, tuple[int, int, int]] = 256,
     if bounds is None:
         bounds = default_mesh_bounds(vertices, faces, resolution)
     grid = Grid.from_bounds(bounds, resolution)
-    if max_memory is not None and (isinstance(max_memory, bool) or not
-                                   isinstance(max_memory, (int, np.integer)) or max_memory <= 0):
-        raise ValueError(f"max_memory must be a positive number of bytes, got {max_memory!r}")
+    budget = memory_budget(max_memory)
     triangles = vertices[faces]
     need = estimate_mesh_memory(triangles, grid, solid)
-    budget = _default_budget() if max_memory is None else int(max_memory)
     if need > budget:
         raise MemoryError(f"voxelizing the mesh at {grid.shape} needs an estimated "
                           f"{need / 2**30:.2f} GiB, over the budget of {budget / 2**30:.2f} GiB; "

@@ -24,7 +24,7 @@ from .shape import as_shape, exact_classifier
 from .subdivide import subdivide
 from .voxels import Voxels
 
-__all__ = ["voxelize", "estimate_memory", "refine_voxels"]
+__all__ = ["voxelize", "estimate_memory", "memory_budget", "refine_voxels"]
 
 #: bytes per surface voxel while collecting and building (coords, codes, sort, tree)
 _BYTES_PER_VOXEL = 48
@@ -42,6 +42,16 @@ def _default_budget() -> int:
     except OSError:
         pass
     return 8 << 30
+
+
+def memory_budget(max_memory: Any) -> int:
+    """The byte budget of a run: ``max_memory`` (checked), or half the available memory."""
+    if max_memory is None:
+        return _default_budget()
+    if isinstance(max_memory, bool) or not isinstance(max_memory, (int, np.integer)) \
+            or max_memory <= 0:
+        raise ValueError(f"max_memory must be a positive number of bytes, got {max_memory!r}")
+    return int(max_memory)
 
 
 def estimate_memory(func: Function, grid: Grid, normals: bool = False) -> tuple[int, int]:
@@ -132,9 +142,7 @@ def voxelize(shape: Any, bounds: Any = None, resolution: Union[int, tuple[int, i
         if bounds is None:
             raise ValueError("bounds is required: the shape has no bounds of its own; pass "
                              "bounds=((x0, y0, z0), (x1, y1, z1))")
-    if max_memory is not None and (isinstance(max_memory, bool) or not
-                                   isinstance(max_memory, (int, np.integer)) or max_memory <= 0):
-        raise ValueError(f"max_memory must be a positive number of bytes, got {max_memory!r}")
+    budget = memory_budget(max_memory)
     if isinstance(subvoxel, bool) or not isinstance(subvoxel, (int, np.integer)) \
             or not 0 <= subvoxel <= 4:
         raise ValueError(f"subvoxel must be an int from 0 to 4, got {subvoxel!r}")
@@ -143,7 +151,6 @@ def voxelize(shape: Any, bounds: Any = None, resolution: Union[int, tuple[int, i
         raise ValueError(f"resolution {grid.shape} with subvoxel={subvoxel} exceeds the octree's "
                          "21 levels")
     func = Function(shape.expr)
-    budget = _default_budget() if max_memory is None else int(max_memory)
     estimated_voxels, estimated_bytes = estimate_memory(func, grid, normals)
     if estimated_bytes > budget:
         raise MemoryError(
