@@ -31,6 +31,7 @@ from implicitvox.shape import AMBIGUOUS, EMPTY, FULL
 from implicitvox.tribox import Triangles
 from implicitvox.crossings import RayWinding
 from implicitvox.mesh_subdivide import _sorted_unique
+from implicitvox.ranges import buckets, expand_boxes, gather
 
 __all__ = ["exact_classifier", "MeshClassifier"]
 
@@ -44,6 +45,15 @@ def _exact_types():
 def _has_mesh(solid) -> bool:
     """Whether a leaf of the tree has an exact test (a polyhedron or a max-norm primitive)."""
     return isinstance(solid, _exact_types()) or any(_has_mesh(c) for c in solid.children)
+
+
+def _similarity_scale(m: np.ndarray) -> Optional[float]:
+    """The scale of ``m`` if it is a rotation (or reflection) times a scale, else None."""
+    gram = m.T @ m
+    scale2 = gram[0, 0]
+    if np.allclose(gram, scale2 * np.eye(3), rtol=0, atol=1e-12 * scale2):
+        return float(np.sqrt(scale2))
+    return None
 
 
 def _linf_leaf(solid, matrix: np.ndarray):
@@ -62,20 +72,16 @@ def _linf_leaf(solid, matrix: np.ndarray):
     if isinstance(solid, HalfSpace):
         n = np.linalg.solve(m.T, solid.normal)          # M^-T n
         return linf.HalfSpace(n, solid.offset + n @ t)
+    k = _similarity_scale(m)
     if isinstance(solid, Sphere):
-        gram = m.T @ m
-        scale2 = gram[0, 0]
-        if np.allclose(gram, scale2 * np.eye(3), rtol=0, atol=1e-12 * scale2):   # similarity
-            return linf.Sphere(m @ solid.center + t, solid.r * np.sqrt(scale2))
+        if k is not None:
+            return linf.Sphere(m @ solid.center + t, solid.r * k)
         return linf.Ellipsoid.from_affine(m * solid.r, m @ solid.center + t)
     if isinstance(solid, Ellipsoid):
         return linf.Ellipsoid.from_affine(m @ np.diag(solid.radii), m @ solid.center + t)
     if isinstance(solid, Cylinder):
-        gram = m.T @ m
-        scale2 = gram[0, 0]
-        if np.allclose(gram, scale2 * np.eye(3), rtol=0, atol=1e-12 * scale2):   # similarity
+        if k is not None:
             z0, _ = solid._z
-            k = np.sqrt(scale2)
             return linf.Frustum(m @ np.array([0.0, 0.0, z0]) + t, m[:, 2], solid.h * k,
                                 solid.r1 * k, solid.r2 * k)
     return None
@@ -200,16 +206,9 @@ class MeshClassifier:
         self.cell_size = span / self.cells
         first = self._cell(self.tris.lo)
         last = self._cell(self.tris.hi)
-        count = np.prod(last - first + 1, axis=1)
-        tri = np.repeat(np.arange(n), count)
-        k = np.arange(len(tri)) - np.repeat(np.cumsum(count) - count, count)
-        c = (last - first + 1)[tri]
-        cell = first[tri] + np.stack([k // (c[:, 1] * c[:, 2]), (k // c[:, 2]) % c[:, 1],
-                                      k % c[:, 2]], axis=1)
+        tri, cell = expand_boxes(first, last)
         key = (cell[:, 0] * self.cells + cell[:, 1]) * self.cells + cell[:, 2]
-        order = np.argsort(key, kind="stable")
-        self.cell_tris = tri[order]
-        self.cell_start = np.searchsorted(key[order], np.arange(self.cells ** 3 + 1))
+        self.cell_tris, self.cell_start = buckets(key, tri, self.cells ** 3)
 
     def _cell(self, p: np.ndarray) -> np.ndarray:
         # a cell index per point, widened by one cell below so rounding cannot drop a triangle
@@ -239,18 +238,10 @@ class MeshClassifier:
         slack on each side covers the cell computation's rounding)."""
         first = np.maximum(self._cell(lo[boxes]) - 1, 0)
         last = np.minimum(self._cell(hi[boxes]) + 1, self.cells - 1)
-        ext = last - first + 1
-        count = np.prod(ext, axis=1)
-        b = np.repeat(np.arange(len(boxes)), count)
-        k = np.arange(len(b)) - np.repeat(np.cumsum(count) - count, count)
-        e = ext[b]
-        cell = first[b] + np.stack([k // (e[:, 1] * e[:, 2]), (k // e[:, 2]) % e[:, 1],
-                                    k % e[:, 2]], axis=1)
+        b, cell = expand_boxes(first, last)
         key = (cell[:, 0] * self.cells + cell[:, 1]) * self.cells + cell[:, 2]
-        n_tris = self.cell_start[key + 1] - self.cell_start[key]
-        pb = np.repeat(b, n_tris)
-        off = np.arange(len(pb)) - np.repeat(np.cumsum(n_tris) - n_tris, n_tris)
-        pt = self.cell_tris[np.repeat(self.cell_start[key], n_tris) + off]
+        pair, index = gather(self.cell_start[key], self.cell_start[key + 1] - self.cell_start[key])
+        pb, pt = b[pair], self.cell_tris[index]
         # a triangle spanning several cells appears once per cell: keep one pair
         if len(pb):
             pair = _sorted_unique(pb.astype(np.int64) * len(self.tris) + pt)

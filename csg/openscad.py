@@ -291,12 +291,17 @@ class _Builder:
             raise self.error(node, "polygon: paths must be lists of point indices")
         return Polygon(p, None if paths is None else [[int(i) for i in q] for q in paths])
 
-    def _linear_extrude(self, node: Node) -> Optional[Solid]:
+    def _section(self, node: Node) -> Optional[Solid]:
+        """The 2D children of an extrusion, united (None when there are none)."""
         body = self._group(node)
+        if body is not None and body.dim != 2:
+            raise self.error(node, f"{node.name}: the children must be 2D")
+        return body
+
+    def _linear_extrude(self, node: Node) -> Optional[Solid]:
+        body = self._section(node)
         if body is None:
             return None
-        if body.dim != 2:
-            raise self.error(node, "linear_extrude: the children must be 2D")
         h = self.number(node, "height", 100.0, 0, positive=True)
         twist = self.number(node, "twist", 0.0)
         scale = self.vector(node, "scale", 2, 1.0)
@@ -337,11 +342,9 @@ class _Builder:
         return meshes[0] if len(meshes) == 1 else Difference(meshes[0], *meshes[1:])
 
     def _rotate_extrude(self, node: Node) -> Optional[Solid]:
-        body = self._group(node)
+        body = self._section(node)
         if body is None:
             return None
-        if body.dim != 2:
-            raise self.error(node, "rotate_extrude: the children must be 2D")
         angle = self.number(node, "angle", 360.0)
         if not self.faceted:
             return RotateExtrude(body, angle)

@@ -206,14 +206,21 @@ def rotation_matrix(axis: Any, degrees: float) -> np.ndarray:
     return c * np.eye(3) + s * k + (1 - c) * np.outer(u, u)
 
 
-class Union(Solid):
-    """Points in any child: ``min`` of the functions."""
+class _NaryBoolean(Solid):
+    """A union or intersection of one or more solids (``combine`` is min or max)."""
+
+    _symbol = ""
+    _name = ""
 
     def __init__(self, *solids: Solid):
         if not solids:
-            raise ValueError("a union needs at least one solid")
-        self._children = tuple(_check_solid(s, "|") for s in solids)
+            raise ValueError(f"{self._name} needs at least one solid")
+        self._children = tuple(_check_solid(s, self._symbol) for s in solids)
         self.dim = max(s.dim for s in self._children)
+
+    @staticmethod
+    def _combine(*exprs: Expr) -> Expr:
+        raise NotImplementedError
 
     @property
     def children(self):
@@ -221,8 +228,15 @@ class Union(Solid):
 
     @property
     def expr(self) -> Expr:
-        return iv.min(*[c.expr for c in self._children]) if len(self._children) > 1 \
+        return self._combine(*[c.expr for c in self._children]) if len(self._children) > 1 \
             else self._children[0].expr
+
+
+class Union(_NaryBoolean):
+    """Points in any child: ``min`` of the functions."""
+
+    _symbol, _name = "|", "a union"
+    _combine = staticmethod(iv.min)
 
     @property
     def bounds(self) -> Bounds:
@@ -233,23 +247,11 @@ class Union(Solid):
                 tuple(np.max([b[1] for b in bs], axis=0).tolist()))
 
 
-class Intersection(Solid):
+class Intersection(_NaryBoolean):
     """Points in every child: ``max`` of the functions."""
 
-    def __init__(self, *solids: Solid):
-        if not solids:
-            raise ValueError("an intersection needs at least one solid")
-        self._children = tuple(_check_solid(s, "&") for s in solids)
-        self.dim = max(s.dim for s in self._children)
-
-    @property
-    def children(self):
-        return self._children
-
-    @property
-    def expr(self) -> Expr:
-        return iv.max(*[c.expr for c in self._children]) if len(self._children) > 1 \
-            else self._children[0].expr
+    _symbol, _name = "&", "an intersection"
+    _combine = staticmethod(iv.max)
 
     @property
     def bounds(self) -> Bounds:

@@ -32,6 +32,7 @@ from __future__ import annotations
 import numpy as np
 
 from .predicates import det2_sign, orient3d_sign
+from .ranges import buckets, expand_boxes, gather
 from .tribox import Triangles
 
 __all__ = ["RayWinding"]
@@ -59,15 +60,9 @@ class RayWinding:
         # and the cell arithmetic rounds
         first = np.maximum(self._cell(lo) - 1, 0)
         last = np.minimum(self._cell(hi) + 1, self.cells - 1)
-        count = np.prod(last - first + 1, axis=1)
-        tri = np.repeat(np.arange(len(keep)), count)
-        k = np.arange(len(tri)) - np.repeat(np.cumsum(count) - count, count)
-        ext = (last - first + 1)[tri]
-        cell = first[tri] + np.stack([k // ext[:, 1], k % ext[:, 1]], axis=1)
+        tri, cell = expand_boxes(first, last)
         key = cell[:, 0] * self.cells + cell[:, 1]
-        order = np.argsort(key, kind="stable")
-        self.cell_tris = keep[tri[order]]
-        self.cell_start = np.searchsorted(key[order], np.arange(self.cells ** 2 + 1))
+        self.cell_tris, self.cell_start = buckets(key, keep[tri], self.cells ** 2)
 
     def _cell(self, p: np.ndarray) -> np.ndarray:
         c = np.floor((p - self.lo2) / self.size).astype(np.int64)
@@ -80,10 +75,8 @@ class RayWinding:
         if not len(self.index) or not len(p):
             return out
         key = self._cell(p[:, 1:]) @ np.array([self.cells, 1])
-        n = self.cell_start[key + 1] - self.cell_start[key]
-        pts = np.repeat(np.arange(len(p)), n)
-        off = np.arange(len(pts)) - np.repeat(np.cumsum(n) - n, n)
-        tri = self.cell_tris[np.repeat(self.cell_start[key], n) + off]
+        pts, index = gather(self.cell_start[key], self.cell_start[key + 1] - self.cell_start[key])
+        tri = self.cell_tris[index]
         t = self.tris
         q = p[pts]
         near = np.all((t.lo[tri][:, 1:] <= q[:, 1:]) & (t.hi[tri][:, 1:] >= q[:, 1:]), axis=1)

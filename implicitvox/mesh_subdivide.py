@@ -35,6 +35,7 @@ import numpy as np
 
 from . import morton
 from .grid import Grid
+from .ranges import expand_boxes
 from .tribox import Triangles, vertex_in_box
 
 __all__ = ["surface_codes", "CHUNK"]
@@ -171,13 +172,7 @@ def _start_pairs(tris: Triangles, grid: Grid) -> list[tuple[int, np.ndarray, np.
     level = level[tri]
     shift = (grid.depth - level)[:, None]
     lo_node, hi_node = first[tri] >> shift, last[tri] >> shift
-    count = hi_node - lo_node + 1
-    total = np.prod(count, axis=1)
-    pair_tri = np.repeat(np.arange(len(tri)), total)
-    k = np.arange(len(pair_tri)) - np.repeat(np.cumsum(total) - total, total)
-    c = count[pair_tri]
-    off = np.stack([k // (c[:, 1] * c[:, 2]), (k // c[:, 2]) % c[:, 1], k % c[:, 2]], axis=1)
-    nodes = lo_node[pair_tri] + off
+    pair_tri, nodes = expand_boxes(lo_node, hi_node)
     out = []
     for lev in range(grid.depth + 1):
         sel = np.flatnonzero(level[pair_tri] == lev)

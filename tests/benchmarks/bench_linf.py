@@ -10,6 +10,7 @@ primitive's box grown by half its size, and for the bunny also near its surface
 """
 from __future__ import annotations
 
+import sys
 import time
 from pathlib import Path
 
@@ -18,10 +19,9 @@ import numpy as np
 from implicitvox import linf
 from implicitvox.mesh_input import as_triangles
 
-BUNNY = next((p for p in (Path(__file__).resolve().parents[3] / "shared" / "data" / "meshes"
-                          / "stanford-bunny.obj",
-                          Path("/work/shared/data/meshes/stanford-bunny.obj")) if p.exists()),
-             Path("/work/shared/data/meshes/stanford-bunny.obj"))
+sys.path.insert(0, str(Path(__file__).resolve().parents[2]))     # the repository root
+from tests.mesh_helpers import BUNNY  # noqa: E402
+
 N = 100_000
 
 

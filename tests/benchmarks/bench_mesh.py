@@ -16,6 +16,7 @@ Prints per resolution, in the same run:
 from __future__ import annotations
 
 import argparse
+import sys
 import time
 from pathlib import Path
 
@@ -24,20 +25,8 @@ import numpy as np
 import implicitvox as ivx
 from implicitvox.mesh_input import as_triangles
 
-BUNNY = next((p for p in (Path(__file__).resolve().parents[3] / "shared" / "data" / "meshes"
-                          / "stanford-bunny.obj",
-                          Path("/work/shared/data/meshes/stanford-bunny.obj")) if p.exists()),
-             Path("/work/shared/data/meshes/stanford-bunny.obj"))
-
-
-def sample_surface(tri: np.ndarray, n: int, rng: np.random.Generator) -> np.ndarray:
-    area = 0.5 * np.linalg.norm(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]), axis=1)
-    pick = rng.choice(len(tri), n, p=area / area.sum())
-    r1, r2 = rng.random(n), rng.random(n)
-    flip = r1 + r2 > 1
-    r1[flip], r2[flip] = 1 - r1[flip], 1 - r2[flip]
-    t = tri[pick]
-    return t[:, 0] + r1[:, None] * (t[:, 1] - t[:, 0]) + r2[:, None] * (t[:, 2] - t[:, 0])
+sys.path.insert(0, str(Path(__file__).resolve().parents[2]))     # the repository root
+from tests.mesh_helpers import BUNNY, sample_surface  # noqa: E402
 
 
 def best_of(repeat: int, run):
