@@ -54,7 +54,7 @@ __all__ = [
     "i_add", "i_sub", "i_mul", "i_div", "i_neg", "i_addc", "i_rsubc", "i_mulc", "i_divc", "i_square", "i_powi", "i_powr",
     "i_sqrt", "i_abs", "i_exp", "i_log", "i_sin", "i_cos", "i_tan", "i_atan",
     "i_asin", "i_acos", "i_atan2", "i_hypot", "i_min", "i_max", "i_floor",
-    "mignitude", "magnitude", "PI_UP", "HALF_PI_UP",
+    "i_distance", "mignitude", "magnitude", "PI_UP", "HALF_PI_UP",
 ]
 
 T = R.TRANSCENDENTAL_ULPS
@@ -348,6 +348,50 @@ def i_radius(ulo, uhi, vlo, vhi, wlo, whi):
     lo = _norm3(mignitude(ulo, uhi), mignitude(vlo, vhi), mignitude(wlo, whi))
     hi = _norm3(magnitude(ulo, uhi), magnitude(vlo, vhi), magnitude(wlo, whi))
     return R.down_nonneg(lo, 3), R.up_nonneg(hi, 3)
+
+
+#: a lower bound of ``sqrt(MAX)``: the least distance whose squared sum overflows
+_SQRT_MAX_DOWN = float(np.sqrt(np.finfo(np.float64).max)) * (1.0 - 2.0 ** -48)
+#: above every rounding error that underflowing squares leave after the root
+_UNDERFLOW_ROOT = 2.0 ** -536
+
+
+def _offset_square_extents(alo, ahi, c: float):
+    """Smallest and largest ``(a - c)**2`` over ``[alo, ahi]``, rounded to nearest.
+
+    ``alo - c`` and ``c - ahi`` are rounded to nearest, which keeps their
+    signs exact and their relative error below ``2**-53``; the nearest point
+    is ``max(alo - c, c - ahi, 0)`` away from ``c``, the farthest
+    ``-min(alo - c, c - ahi)``.
+    """
+    below = alo - c
+    above = c - ahi
+    near = np.maximum(np.maximum(below, above), 0.0)
+    far = np.minimum(below, above)
+    return near * near, far * far
+
+
+def i_distance(alo, ahi, blo, bhi, wlo, whi, centre):
+    """Euclidean distance from ``centre`` over the box ``[a] x [b] x [w]``.
+
+    The tape's fused form of ``sqrt((a - c0)**2 + (b - c1)**2 + (w - c2)**2)``
+    (spheres, cylinders, blobs): from the box's nearest point to its farthest,
+    which is tighter than the operation-by-operation enclosure and rounds once
+    instead of after every step. Rounding: each offset ``a - c`` carries a
+    relative error of at most ``u = 2**-53`` (its sign is exact), each square
+    ``3u``, the two sums ``5u`` and the root ``3.5u`` in all (first order), so
+    the ends move 3 floats (``6u``) outward. Squares that underflow lose at
+    most ``2**-1075`` each, ``2**-536`` after the root; a sum that overflows
+    means a distance of at least :data:`_SQRT_MAX_DOWN`, where the lower end is
+    clamped (the upper is then ``inf``).
+    """
+    c0, c1, c2 = centre
+    n0, f0 = _offset_square_extents(alo, ahi, c0)
+    n1, f1 = _offset_square_extents(blo, bhi, c1)
+    n2, f2 = _offset_square_extents(wlo, whi, c2)
+    lo = np.sqrt((n0 + n1) + n2) * (1.0 - 3.0 * R.EPS) - _UNDERFLOW_ROOT
+    hi = np.sqrt((f0 + f1) + f2) * (1.0 + 3.0 * R.EPS) + _UNDERFLOW_ROOT
+    return np.clip(lo, 0.0, _SQRT_MAX_DOWN), hi
 
 
 def i_elevation(ulo, uhi, vlo, vhi, wlo, whi):

@@ -156,6 +156,13 @@ def _d_radius(v, g, out, p):
     return I.i_div(*num, *out), None
 
 
+def _d_distance(v, g, out, p):
+    offsets = [I.i_addc(*vi, -ci) for vi, ci in zip(v, p)]
+    num = I.i_add(*I.i_add(*I.i_mul(*offsets[0], *g[0]), *I.i_mul(*offsets[1], *g[1])),
+                  *I.i_mul(*offsets[2], *g[2]))
+    return I.i_div(*num, *out), None
+
+
 def _holds_origin(*intervals):
     held = True
     for lo, hi in intervals:
@@ -187,7 +194,7 @@ def _d_periodic_angle(v, g, out, p):
 RULES = {
     "repeat": lambda v, g, o, p: p.interval_derivative(v, g, o, p),
     "repeat_polar": lambda v, g, o, p: p.interval_derivative(v, g, o, p),
-    "radius": _d_radius, "elevation": _d_elevation, "periodic_angle": _d_periodic_angle,
+    "radius": _d_radius, "distance": _d_distance, "elevation": _d_elevation, "periodic_angle": _d_periodic_angle,
     "add": _d_add, "sub": _d_sub, "mul": _d_mul, "div": _d_div,
     "neg": lambda v, g, o, p: (I.i_neg(*g[0]), None),
     "addc": lambda v, g, o, p: (g[0], None),

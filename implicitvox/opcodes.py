@@ -191,6 +191,21 @@ def _mp_periodic_angle(a, p):
     return (mpmath.sin if fn == "sin" else mpmath.cos)(k * angle + c)
 
 
+def _point_distance(a, p):
+    # the unfused tape's order exactly: ((a0 - c0)^2 + (a1 - c1)^2) + (a2 - c2)^2
+    total = np.square(a[0] - p[0]) + np.square(a[1] - p[1])
+    total = total + np.square(a[2] - p[2])
+    return np.sqrt(total)
+
+
+def _d_distance(v, g, out, p):
+    return ((v[0] - p[0]) * g[0] + (v[1] - p[1]) * g[1] + (v[2] - p[2]) * g[2]) / out
+
+
+def _mp_distance(a, p):
+    return mpmath.sqrt(sum((ai - mpmath.mpf(ci)) ** 2 for ai, ci in zip(a, p)))
+
+
 def prepared(op: str, param: Any) -> Any:
     """The compiled sweep of a ``repeat``/``repeat_polar`` parameter (imported
     late: sweeps evaluate tapes, which read this table)."""
@@ -265,6 +280,11 @@ _ROWS = [
          lambda lo, hi, p: I.i_radius(lo[0], hi[0], lo[1], hi[1], lo[2], hi[2]),
          lambda v, g, o, p: (v[0] * g[0] + v[1] * g[1] + v[2] * g[2]) / o,
          lambda a, p: mpmath.sqrt(a[0] ** 2 + a[1] ** 2 + a[2] ** 2)),
+    # The tape's fused sqrt((a - c0)^2 + (b - c1)^2 + (w - c2)^2); the parameter
+    # is the centre (c0, c1, c2). Spheres, cylinders and blobs are made of it.
+    _row("distance", 3, _point_distance,
+         lambda lo, hi, p: I.i_distance(lo[0], hi[0], lo[1], hi[1], lo[2], hi[2], p),
+         _d_distance, _mp_distance, internal=True),
     _row("elevation", 3, lambda a, p: np.arctan2(a[2], np.hypot(a[0], a[1])),
          lambda lo, hi, p: I.i_elevation(lo[0], hi[0], lo[1], hi[1], lo[2], hi[2]),
          _d_elevation, _mp_elevation),

@@ -45,14 +45,16 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["down", "up", "down_nonneg", "up_nonneg", "TRANSCENDENTAL_ULPS", "POW_ULPS"]
+__all__ = ["down", "up", "down_nonneg", "up_nonneg", "TRANSCENDENTAL_ULPS", "POW_ULPS", "EPS"]
 
 #: floats of outward widening after numpy's transcendental functions.
 TRANSCENDENTAL_ULPS = 4
 #: floats after ``np.power`` (libm ``pow``) and ``np.hypot``.
 POW_ULPS = 2
 
-_EPS = 2.0 ** -52
+#: the spacing of floats at 1 (one ulp of 1.0)
+EPS = 2.0 ** -52
+_EPS = EPS
 _TINY = 2.0 ** -1074
 _MAX = float(np.finfo(np.float64).max)
 

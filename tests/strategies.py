@@ -45,6 +45,8 @@ def param_for(draw, name: str):
     if name == "periodic_angle":
         return (draw(st.sampled_from(["sin", "cos"])), float(draw(st.integers(-9, 9))),
                 draw(st.floats(-3.0, 3.0)))
+    if name == "distance":
+        return tuple(draw(anywhere) for _ in range(3))
     if name == "divc":
         return draw(anywhere.filter(lambda v: v != 0.0))
     if name == "powr":

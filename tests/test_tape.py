@@ -65,3 +65,59 @@ def test_constant_and_variable_outputs_broadcast():
     assert ivx.compile(ivx.constant(2.0))(np.zeros(4), 0, 0).shape == (4,)
     lo, hi = ivx.compile(y).interval(np.zeros((5, 3)), np.ones((5, 3)))
     assert lo.shape == (5,) and hi[0] == 1.0
+
+
+#: (expression, its fused centre, the same sum written in numpy)
+SPHERES = [
+    (ivx.sqrt((x - 0.3) ** 2 + (y + 0.2) ** 2 + (z - 1e-3) ** 2), (0.3, -0.2, 1e-3),
+     lambda X, Y, Z: np.sqrt(np.square(X - 0.3) + np.square(Y + 0.2) + np.square(Z - 1e-3))),
+    (ivx.sqrt(x * x + y * y + z * z), (0.0, 0.0, 0.0),
+     lambda X, Y, Z: np.sqrt(X * X + Y * Y + Z * Z)),
+    (ivx.sqrt(ivx.square(z - 2.5) + ivx.square(x)), (2.5, 0.0, 0.0),
+     lambda X, Y, Z: np.sqrt(np.square(Z - 2.5) + np.square(X))),
+]
+
+
+def test_distance_from_a_centre_is_fused_with_the_same_point_values():
+    rng = np.random.default_rng(5)
+    pts = rng.uniform(-3, 3, (3, 20_000))
+    for expr, centre, unfused in SPHERES:
+        tape = build_tape(expr)
+        assert names(tape) == ["distance"] and tape.instructions[0].param == centre
+        assert np.array_equal(ivx.compile(expr)(*pts), unfused(*pts))  # bit for bit
+
+
+def test_distance_is_not_fused_from_other_sums():
+    for expr in (ivx.sqrt(x * x + y), ivx.sqrt(x * x + y * y + z * z + 1.0),
+                 ivx.sqrt(x * y + z * z), ivx.hypot(x - 1, y)):
+        assert "distance" not in names(build_tape(expr)), expr
+
+
+def test_fused_distance_is_the_exact_range_rounded_outward():
+    """Nearest and farthest box points from the centre, at 60 digits, inside and close."""
+    rng = np.random.default_rng(6)
+    centre = (0.3, -0.2, 1e-3)
+    f = ivx.compile(SPHERES[0][0])
+    lo = rng.uniform(-1, 1, (2000, 3)) * rng.choice([1e-9, 1.0, 1e6], (2000, 1))
+    hi = lo + rng.uniform(0, 1, (2000, 3)) * rng.choice([0.0, 1e-9, 1.0], (2000, 1))
+    flo, fhi = f.interval(lo, hi)
+    with mpmath.workdps(60):
+        for i in range(0, 2000, 7):
+            a = [mpmath.mpf(v) for v in lo[i]]
+            b = [mpmath.mpf(v) for v in hi[i]]
+            c = [mpmath.mpf(v) for v in centre]
+            near = [max(a[k] - c[k], c[k] - b[k], 0) for k in range(3)]
+            far = [max(abs(a[k] - c[k]), abs(b[k] - c[k])) for k in range(3)]
+            dmin = mpmath.sqrt(sum(t * t for t in near))
+            dmax = mpmath.sqrt(sum(t * t for t in far))
+            assert flo[i] <= dmin and dmax <= fhi[i], i
+            # tight: a few ulps wide beyond the exact range (no looser than 8 ulps + underflow)
+            assert dmin - flo[i] <= 8 * np.spacing(float(dmin)) + 2.0 ** -530
+            assert fhi[i] - dmax <= 8 * np.spacing(float(dmax)) + 2.0 ** -530
+
+
+def test_fused_distance_survives_overflow_and_infinite_ends():
+    f = ivx.compile(SPHERES[1][0])
+    lo, hi = f.interval([[1e200, 0, 0], [-np.inf, 1.0, 1.0]], [[2e200, 1, 1], [np.inf, 2.0, 2.0]])
+    assert 1e154 < lo[0] <= 1e200 and hi[0] == np.inf      # the squares overflow
+    assert lo[1] <= np.sqrt(2.0) and hi[1] == np.inf and not np.isnan(lo).any()
