@@ -8,6 +8,7 @@ from scipy.optimize import linprog
 import implicitvox as ivx
 from implicitvox import linf
 from implicitvox.shape import AMBIGUOUS, EMPTY, FULL
+from tests.linf_oracle import corner_depth, dual_distance, ellipsoid_support, frustum_support
 
 CUBE = np.array([[x, y, z] for x in (0, 1) for y in (0, 1) for z in (0, 1)], dtype=float)
 
@@ -192,36 +193,42 @@ def test_voxelizing_a_rotated_box_gives_exactly_the_voxels_it_meets():
     assert np.array_equal(got, want)
 
 
-def test_ellipsoid_matches_a_convex_programme():
-    """Brute force: min t s.t. x in E, |x - p| <= t w (outside), or the largest box of
-    corners in E (inside), each solved by SLSQP from two starts."""
-    from scipy.optimize import minimize
+def near_surface(rng, surface_points, n, spread):
+    """Points scattered around given surface points (edges, rims, apexes): ``spread`` wide."""
+    base = surface_points[rng.integers(0, len(surface_points), n)]
+    return base + rng.normal(size=(n, 3)) * spread * rng.choice([1e-9, 1e-4, 1e-1], (n, 1))
+
+
+def check_against_oracle(d, p, w, support, inside):
+    """D matches the dual brute force outside and the corner bisection inside, to 1e-9
+    relative, or 1e-12 absolute for the points within 1e-3 of the surface (the
+    coordinates, about 1, are themselves rounded at 1e-16)."""
+    out = d > 0
+    lower = dual_distance(support, p[out], w[out])
+    depth = corner_depth(inside, p[~out], w[~out])
+    assert np.all(lower <= d[out] * (1 + 1e-12) + 1e-13)         # a bound on the true value
+    np.testing.assert_allclose(d[out], lower, rtol=1e-9, atol=1e-12)
+    np.testing.assert_allclose(d[~out], depth, rtol=1e-9, atol=1e-12)
+    return out.sum(), (~out).sum()
+
+
+def test_ellipsoid_matches_brute_force_on_ten_thousand_points():
+    """10^4 points: spread around, near the surface, near the axis ends (the vertices of
+    the support function); against duality (outside) and corner bisection (inside)."""
     rng = np.random.default_rng(6)
     e = linf.Ellipsoid((0.1, -0.2, 0.3), (1.5, 0.7, 0.4), _rotation(rng))
-    p = rng.normal(size=(300, 3)) * 1.5
-    w = rng.uniform(0.5, 2, (300, 3))
+    ends = e.center + (e.rotation * e.radii).T
+    ends = np.concatenate([ends, 2 * e.center - ends])
+    on_surface = e.center + rng.normal(size=(2000, 3))
+    y = on_surface - e.center
+    on_surface = e.center + y / np.sqrt(np.einsum("ni,ij,nj->n", y, e.Q, y))[:, None]
+    p = np.concatenate([rng.normal(size=(5000, 3)) * 1.5, near_surface(rng, ends, 1000, 1.0),
+                        near_surface(rng, on_surface, 4000, 1.0)])
+    w = rng.uniform(0.5, 2, (len(p), 3))
     d = e.distance(p, w)
-    signs = np.array([[a, b, c] for a in (-1, 1) for b in (-1, 1) for c in (-1, 1)])
-
-    def inside(v):
-        return 1 - (v - e.center) @ e.Q @ (v - e.center)
-
-    for i in range(len(p)):
-        if d[i] > 0:
-            cons = [{"type": "ineq", "fun": lambda v: inside(v[:3])},
-                    {"type": "ineq", "fun": lambda v, i=i: v[3] * w[i] - (v[:3] - p[i])},
-                    {"type": "ineq", "fun": lambda v, i=i: v[3] * w[i] + (v[:3] - p[i])}]
-            best = min(minimize(lambda v: v[3], np.r_[s, 5.0], constraints=cons, method="SLSQP",
-                                options={"ftol": 1e-15, "maxiter": 500}).fun
-                       for s in (e.center, p[i]))
-        else:                  # bisection: the largest box whose 8 corners are in E
-            a, b = 0.0, 10.0
-            for _ in range(100):
-                t = 0.5 * (a + b)
-                a, b = (t, b) if all(inside(p[i] + t * s * w[i]) >= 0 for s in signs) \
-                    else (a, t)
-            best = -a
-        assert d[i] == pytest.approx(best, rel=1e-7, abs=1e-9), i
+    inside = lambda X: np.einsum("...i,ij,...j->...", X - e.center, e.Q, X - e.center) <= 1
+    n_out, n_in = check_against_oracle(d, p, w, ellipsoid_support(e.center, e.Qinv), inside)
+    assert n_out > 3000 and n_in > 1000
     sphere = linf.Sphere((0.1, 0.2, 0.3), 0.8)
     as_ellipsoid = linf.Ellipsoid((0.1, 0.2, 0.3), (0.8, 0.8, 0.8))
     q = rng.normal(size=(10_000, 3))
@@ -279,52 +286,40 @@ CYLINDERS = {"cylinder z": ((0, 0, 1), 0.5, 0.5), "cylinder x": ((1, 0, 0), 0.5,
              "cone rotated": (None, 0.6, 0.0)}
 
 
+def _rims(cyl, n, rng):
+    """Points on the two rim circles (an apex where a radius is 0)."""
+    u = np.cross(cyl.a, [1.0, 0, 0] if abs(cyl.a[0]) < 0.9 else [0, 1.0, 0])
+    u /= np.linalg.norm(u)
+    v = np.cross(cyl.a, u)
+    ang = rng.uniform(0, 2 * np.pi, (n, 1))
+    ring = np.cos(ang) * u + np.sin(ang) * v
+    end = rng.integers(0, 2, (n, 1))
+    return cyl.c + end * cyl.h * cyl.a + np.where(end, cyl.r2, cyl.r1) * ring
+
+
 @pytest.mark.parametrize("name", list(CYLINDERS))
-def test_cylinder_matches_a_convex_programme(name):
-    from scipy.optimize import minimize
+def test_cylinder_matches_brute_force_on_ten_thousand_points(name):
+    """10^4 points: spread around, on and near the axis line (the degenerate case of the
+    side's quadratic), near the rims and apexes; duality outside, corner bisection inside."""
     rng = np.random.default_rng(len(name))
     axis, r1, r2 = CYLINDERS[name]
     a = _rotation(rng)[:, 0] if axis is None else axis
     cyl = linf.Frustum((0.1, 0.2, -0.3), a, 1.2, r1, r2)
-    n = 80
-    p = rng.normal(size=(n, 3)) * 1.2
-    p[:20] = cyl.c + rng.uniform(-0.5, 1.7, (20, 1)) * cyl.a     # on the axis line
-    w = rng.uniform(0.5, 2, (n, 3))
+    p = np.concatenate([rng.normal(size=(5000, 3)) * 1.2,
+                        cyl.c + rng.uniform(-0.5, 1.7, (2000, 1)) * cyl.a,
+                        near_surface(rng, _rims(cyl, 1000, rng), 3000, 1.0)])
+    w = rng.uniform(0.5, 2, (len(p), 3))
     d = cyl.distance(p, w)
-    g = _cylinder_constraints(cyl)
-    signs = np.array([[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)])
-    for i in range(n):
-        if d[i] > 0:
-            cons = [{"type": "ineq", "fun": g},
-                    {"type": "ineq", "fun": lambda v, i=i: v[3] * w[i] - (v[:3] - p[i])},
-                    {"type": "ineq", "fun": lambda v, i=i: v[3] * w[i] + (v[:3] - p[i])}]
-            best, slack = np.inf, 0.0
-            for start in (cyl.c + 0.5 * cyl.h * cyl.a, p[i], cyl.c, cyl.c + cyl.h * cyl.a,
-                          cyl.c + 0.1 * cyl.h * cyl.a, cyl.c + 0.9 * cyl.h * cyl.a):
-                r = minimize(lambda v: v[3], np.r_[start, 10.0], constraints=cons,
-                             method="SLSQP", options={"ftol": 1e-15, "maxiter": 1000})
-                # SLSQP may stop on a line-search note at the optimum: keep any feasible end
-                violation = max(0.0, -g(r.x).min(),
-                                float(np.max(np.abs(r.x[:3] - p[i]) - r.x[3] * w[i])))
-                if violation < 1e-8 and r.x[3] < best:
-                    best, slack = r.x[3], violation
-            for s_end, rad in ((0.0, cyl.r1), (cyl.h, cyl.r2)):
-                if rad == 0:             # an apex is a point of K: its distance bounds too
-                    apex = cyl.c + s_end * cyl.a
-                    t_apex = float(np.max(np.abs(apex - p[i]) / w[i]))
-                    if t_apex < best:
-                        best, slack = t_apex, 0.0
-            # the brute force is as exact as its end point is feasible: allow for that
-            assert d[i] == pytest.approx(best, rel=1e-9, abs=1e-12 + 100 * slack), (i, p[i])
-            continue
-        else:                  # bisection: the largest box whose 8 corners are in K
-            lo_t, hi_t = 0.0, 10.0
-            for _ in range(100):
-                t = 0.5 * (lo_t + hi_t)
-                ok = all(g(p[i] + t * s * w[i]).min() >= 0 for s in signs)
-                lo_t, hi_t = (t, hi_t) if ok else (lo_t, t)
-            best = -lo_t
-        assert d[i] == pytest.approx(best, rel=1e-7, abs=1e-9), (i, p[i])
+
+    def inside(X):
+        y = X - cyl.c
+        s = y @ cyl.a
+        perp = y - s[..., None] * cyl.a
+        return (s >= 0) & (s <= cyl.h) & (np.sqrt(np.sum(perp * perp, -1)) <= cyl.radius(s))
+
+    support = frustum_support(cyl.c, cyl.a, cyl.h, cyl.r1, cyl.r2)
+    n_out, n_in = check_against_oracle(d, p, w, support, inside)
+    assert n_out > 3000 and n_in > 500
 
 
 def test_voxelizing_a_rotated_cylinder_gives_exactly_the_voxels_it_meets():

@@ -63,6 +63,12 @@ class Frustum:
         if not (self.h > 0 and self.r1 >= 0 and self.r2 >= 0 and max(r1, r2) > 0):
             raise ValueError(f"h must be positive and the radii >= 0 (not both 0), got "
                              f"h={h!r}, r1={r1!r}, r2={r2!r}")
+        if self.r2 == 0.0:
+            # a cone is kept with its apex at the base: the quadric below is then
+            # homogeneous in y = x - apex, so it keeps its precision near the apex,
+            # where the terms of an off-apex origin would cancel to rounding noise
+            self.c, self.a = self.c + self.h * self.a, -self.a
+            self.r1, self.r2 = 0.0, self.r1
         self.k = (self.r2 - self.r1) / self.h             # radius slope along the axis
         self.r = max(self.r1, self.r2)
         self.M = np.eye(3) - np.outer(self.a, self.a)

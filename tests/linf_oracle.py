@@ -1,0 +1,100 @@
+"""Vectorized brute-force oracles for max-norm distances to convex solids.
+
+Independent of :mod:`implicitvox.linf` (no contact equations), fast enough
+for 10^4 points per test:
+
+* outside, by duality: for a convex ``K`` and ``p`` outside it,
+  ``D_w(p, K) = max { u.p - h_K(u) : sum_i w_i |u_i| <= 1 }`` with ``h_K``
+  the support function of ``K`` (the dual of the weighted max-norm is the
+  weighted 1-norm). The objective is concave and 1-homogeneous, so the
+  maximum lies on the boundary of the cross-polytope, whose 8 triangular
+  faces are searched by nested golden sections (:func:`dual_distance`);
+* inside: ``K`` is convex, so a box lies in ``K`` iff its 8 corners do; the
+  largest such box around ``p`` by bisection on its size.
+"""
+from __future__ import annotations
+
+from typing import Callable
+
+import numpy as np
+
+SIGNS = np.array([[a, b, c] for a in (-1, 1) for b in (-1, 1) for c in (-1, 1)], dtype=float)
+
+
+_GOLD = (np.sqrt(5.0) - 1.0) / 2.0
+
+
+def _golden_max(f, lo, hi, iterations):
+    """Maximum of functions ``f(t)`` unimodal on ``[lo, hi]`` (arrays), by golden section."""
+    a, b = lo, hi
+    c, d = b - _GOLD * (b - a), a + _GOLD * (b - a)
+    fc, fd = f(c), f(d)
+    for _ in range(iterations):
+        left = fc >= fd                      # the maximum is in [a, d]
+        a, b = np.where(left, a, c), np.where(left, d, b)
+        c_new = np.where(left, b - _GOLD * (b - a), d)
+        d_new = np.where(left, c, a + _GOLD * (b - a))
+        f_new = f(np.where(left, c_new, d_new))
+        fc, fd = np.where(left, f_new, fd), np.where(left, fc, f_new)
+        c, d = c_new, d_new
+    return np.maximum(fc, fd)
+
+
+def dual_distance(support: Callable[[np.ndarray], np.ndarray], p: np.ndarray, w: np.ndarray,
+                  iterations: int = 56) -> np.ndarray:
+    """``D_w(p, K)`` for points outside ``K``, by duality, to about 1e-12 relative.
+
+    The objective ``F(u) = u.p - h(u)`` is concave, so on each of the 8 faces
+    ``u = sigma * lam / w`` (``lam`` in the unit simplex) of the dual ball it
+    is concave in ``lam``; its maximum over a face is a nested golden-section
+    search (``max over lam_1`` of ``max over lam_2``, both concave, hence
+    unimodal; kinks do not matter). The value at any ``u`` is a lower bound.
+    """
+    n = len(p)
+    sigma = SIGNS[:, None, :]                                    # (8, 1, 3)
+    P, W = p[None], w[None]                                      # (1, n, 3)
+
+    def F(l1, l2):
+        lam = np.stack([l1, l2, np.maximum(1.0 - l1 - l2, 0.0)], axis=-1)
+        u = sigma * lam / W
+        return np.sum(u * P, axis=-1) - support(u)
+
+    def inner(l1):
+        return _golden_max(lambda l2: F(l1, l2), np.zeros_like(l1), 1.0 - l1, iterations)
+
+    zero = np.zeros((8, n))
+    best = _golden_max(inner, zero, zero + 1.0, iterations)      # (8, n)
+    return best.max(axis=0)
+
+
+def corner_depth(inside: Callable[[np.ndarray], np.ndarray], p: np.ndarray, w: np.ndarray,
+                 t_max: float = 10.0, iterations: int = 80) -> np.ndarray:
+    """``-t`` for the largest box ``p + t [-w, w]`` whose 8 corners satisfy ``inside``
+    (``inside(points (..., 3)) -> bool``); ``K`` convex."""
+    lo = np.zeros(len(p))
+    hi = np.full(len(p), t_max)
+    for _ in range(iterations):
+        t = 0.5 * (lo + hi)
+        corners = p[:, None, :] + t[:, None, None] * SIGNS[None] * w[:, None, :]
+        ok = inside(corners).all(axis=1)
+        lo = np.where(ok, t, lo)
+        hi = np.where(ok, hi, t)
+    return -lo
+
+
+def ellipsoid_support(center: np.ndarray, Qinv: np.ndarray):
+    """``h(u) = u.c + sqrt(u^T Q^-1 u)`` of ``{x : (x - c)^T Q (x - c) <= 1}``."""
+    def h(u):
+        return u @ center + np.sqrt(np.einsum("...i,ij,...j->...", u, Qinv, u))
+    return h
+
+
+def frustum_support(base: np.ndarray, axis: np.ndarray, height: float, r1: float, r2: float):
+    """``h(u)`` of the convex hull of the two end disks of a capped cone or frustum."""
+    top = base + height * axis
+
+    def h(u):
+        perp = u - (u @ axis)[..., None] * axis     # not |u|^2 - (u.a)^2: that cancels
+        across = np.sqrt(np.einsum("...i,...i->...", perp, perp))
+        return np.maximum(u @ base + r1 * across, u @ top + r2 * across)
+    return h
