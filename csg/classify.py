@@ -16,9 +16,18 @@ leaf classifies boxes as EMPTY, FULL or AMBIGUOUS:
 * a function by its interval enclosure (sound; AMBIGUOUS may be a near miss).
 
 The booleans combine the states: a union is FULL if a child is, EMPTY if all
-are, else AMBIGUOUS; an intersection dually; a complement swaps FULL and
-EMPTY. AMBIGUOUS combined with AMBIGUOUS stays AMBIGUOUS (the surfaces may
-cancel inside the box: conservative, never a missed voxel).
+are, AMBIGUOUS if exactly one child is and the others are EMPTY (the union's
+surface in the box is that child's); an intersection dually; a complement
+swaps FULL and EMPTY. Where two children are AMBIGUOUS the state is
+*unknown* - the surfaces may cancel inside the box - and the box is settled
+by subdivision (:func:`_settle`): its surface is met iff a sub-box is
+AMBIGUOUS by the rules above, or one sub-box is FULL and another EMPTY (the
+box is connected); EMPTY or FULL iff every sub-box is. A box still unknown
+after :data:`SETTLE_DEPTH` halvings (two surfaces touching at a tangency)
+counts as AMBIGUOUS: conservative, never a missed voxel. So a union,
+intersection or difference of exact leaves voxelizes exactly, ties aside.
+An interval leaf's AMBIGUOUS is not exact (it may be a near miss): combined
+with another AMBIGUOUS child it stays AMBIGUOUS, without subdivision.
 """
 from __future__ import annotations
 
@@ -33,7 +42,16 @@ from implicitvox.crossings import RayWinding
 from implicitvox.mesh_subdivide import _sorted_unique
 from implicitvox.ranges import buckets, expand_boxes, gather
 
-__all__ = ["exact_classifier", "MeshClassifier"]
+__all__ = ["exact_classifier", "MeshClassifier", "SETTLE_DEPTH"]
+
+#: internal states: two or more exact children AMBIGUOUS (settled by subdivision), and
+#: an interval (not exact) AMBIGUOUS, which stays AMBIGUOUS through the booleans
+UNKNOWN, MAYBE = 3, 4
+#: halvings of a box whose state is unknown before it counts as AMBIGUOUS
+SETTLE_DEPTH = 2
+#: unknown boxes settled at once (each may have up to 4**SETTLE_DEPTH sub-boxes in play)
+SETTLE_CHUNK = 2048
+_HALF = np.array([[(k >> a) & 1 for a in range(3)] for k in range(8)], dtype=bool)
 
 
 def _exact_types():
@@ -110,15 +128,32 @@ def _leaves(solid):
         yield from _leaves(c)
 
 
-def exact_classifier(solid) -> Optional[Callable[[np.ndarray, np.ndarray], np.ndarray]]:
-    """The tree's box classifier, or None when no leaf has an exact test."""
+def exact_classifier(solid, settle: bool = False
+                     ) -> Optional[Callable[[np.ndarray, np.ndarray], np.ndarray]]:
+    """The tree's box classifier, or None when no leaf has an exact test.
+
+    With ``settle``, boxes whose state is unknown (two exact surfaces meet
+    them) are decided by subdivision (:func:`_settle`); without, they are
+    AMBIGUOUS - right for an octant the voxelizer will subdivide anyway, and
+    much cheaper. The voxelizer settles at the voxel level only.
+    """
     if not _has_mesh(solid):
         return None
     cache = solid.__dict__.setdefault("_classifier_cache", {})
     if "plan" not in cache:
         cache["plan"] = _plan(solid, np.eye(4))
     plan = cache["plan"]
-    return lambda lo, hi: _run(plan, np.asarray(lo, dtype=float), np.asarray(hi, dtype=float))
+
+    def classify(lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+        lo, hi = np.asarray(lo, dtype=float), np.asarray(hi, dtype=float)
+        state = _run(plan, lo, hi)
+        unknown = np.flatnonzero(state == UNKNOWN) if settle else np.zeros(0, dtype=np.int64)
+        for start in range(0, len(unknown), SETTLE_CHUNK):
+            part = unknown[start:start + SETTLE_CHUNK]
+            state[part] = _settle(plan, lo[part], hi[part])
+        state[(state == MAYBE) | (state == UNKNOWN)] = AMBIGUOUS
+        return state
+    return classify
 
 
 def _plan(solid, matrix: np.ndarray) -> tuple:
@@ -163,7 +198,7 @@ def _run(plan: tuple, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
     kind = plan[0]
     if kind == "function":
         flo, fhi = plan[1].interval(lo, hi)
-        state = np.full(len(lo), AMBIGUOUS, dtype=np.int8)
+        state = np.full(len(lo), MAYBE, dtype=np.int8)
         state[flo > 0] = EMPTY
         state[fhi < 0] = FULL
         return state
@@ -174,17 +209,57 @@ def _run(plan: tuple, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
     if kind == "complement":
         s = _run(plan[1], lo, hi)
         return np.where(s == FULL, EMPTY, np.where(s == EMPTY, FULL, s)).astype(np.int8)
-    states = [_run(k, lo, hi) for k in plan[1]]
-    if kind == "union":
-        full = np.any([s == FULL for s in states], axis=0)
-        empty = np.all([s == EMPTY for s in states], axis=0)
-    else:
-        full = np.all([s == FULL for s in states], axis=0)
-        empty = np.any([s == EMPTY for s in states], axis=0)
-    out = np.full(len(lo), AMBIGUOUS, dtype=np.int8)
-    out[full] = FULL
-    out[empty] = EMPTY
+    states = np.array([_run(k, lo, hi) for k in plan[1]])
+    # a union is an intersection of complements: one rule, with the roles swapped
+    absorbing, neutral = (FULL, EMPTY) if kind == "union" else (EMPTY, FULL)
+    out = np.full(len(lo), UNKNOWN, dtype=np.int8)
+    active = states != neutral
+    n_active = active.sum(axis=0)
+    single = n_active == 1
+    if single.any():               # exactly one child decides: its state (AMBIGUOUS or unknown)
+        out[single] = states[active.argmax(axis=0)[single], np.flatnonzero(single)]
+    out[(n_active > 1) & (states == MAYBE).any(axis=0)] = MAYBE
+    out[n_active == 0] = neutral
+    out[(states == absorbing).any(axis=0)] = absorbing
     return out
+
+
+def _settle(plan: tuple, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+    """Decide boxes of UNKNOWN state by halving them, level by level, all at once.
+
+    A box meets the surface iff a sub-box does (an AMBIGUOUS sub-box), or it
+    holds an inside and an outside sub-box (FULL and EMPTY: the box is
+    connected); it is EMPTY (FULL) iff all its sub-boxes are. Unknown after
+    :data:`SETTLE_DEPTH` levels: AMBIGUOUS.
+    """
+    state = np.full(len(lo), UNKNOWN, dtype=np.int8)
+    owner = np.arange(len(lo))
+    seen_full = np.zeros(len(state), dtype=bool)
+    seen_empty = np.zeros(len(state), dtype=bool)
+    blo, bhi = lo[owner], hi[owner]
+    for _ in range(SETTLE_DEPTH):
+        if not len(owner):
+            break
+        mid = 0.5 * (blo + bhi)
+        clo = np.where(_HALF[None], mid[:, None], blo[:, None]).reshape(-1, 3)
+        chi = np.where(_HALF[None], bhi[:, None], mid[:, None]).reshape(-1, 3)
+        cowner = np.repeat(owner, 8)
+        s = _run(plan, clo, chi)
+        seen_full[cowner[s == FULL]] = True
+        seen_empty[cowner[s == EMPTY]] = True
+        surface = np.zeros(len(state), dtype=bool)
+        surface[cowner[(s == AMBIGUOUS) | (s == MAYBE)]] = True
+        surface |= seen_full & seen_empty
+        pending = np.zeros(len(state), dtype=bool)
+        pending[cowner[s == UNKNOWN]] = True
+        decided_owner = np.unique(owner)
+        state[decided_owner[surface[decided_owner]]] = AMBIGUOUS
+        settled = decided_owner[~surface[decided_owner] & ~pending[decided_owner]]
+        state[settled] = np.where(seen_full[settled], FULL, EMPTY)
+        keep = (s == UNKNOWN) & ~surface[cowner]
+        owner, blo, bhi = cowner[keep], clo[keep], chi[keep]
+    state[state == UNKNOWN] = AMBIGUOUS
+    return state
 
 
 class MeshClassifier:

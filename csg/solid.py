@@ -117,6 +117,13 @@ class Solid:
         from .classify import exact_classifier
         return exact_classifier(self)
 
+    @property
+    def classify_voxels(self) -> Optional[Callable[[np.ndarray, np.ndarray], np.ndarray]]:
+        """The exact test at the voxel level: as :attr:`classify_boxes`, and where two
+        exact surfaces meet a box, decided by subdividing it (:mod:`csg.classify`)."""
+        from .classify import exact_classifier
+        return exact_classifier(self, settle=True)
+
     def voxelize(self, resolution: Any = 256, bounds: Any = None, **options: Any) -> iv.Voxels:
         """:func:`implicitvox.voxelize` this solid (bounds default to its own)."""
         if self.dim != 3:

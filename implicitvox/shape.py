@@ -11,7 +11,10 @@ A shape has
   :data:`AMBIGUOUS`, where AMBIGUOUS means the surface does meet the closed
   box (Varadhan §5.1). The voxelizer calls it on boxes that interval
   arithmetic left AMBIGUOUS; at the target depth a voxel is kept iff it says
-  AMBIGUOUS.
+  AMBIGUOUS;
+* ``classify_voxels(lo, hi)`` (optional) - the same at the target depth, for
+  shapes whose ``classify_boxes`` may leave a box undecided (AMBIGUOUS) to
+  save work on octants that will be subdivided anyway (:mod:`csg` booleans).
 
 A bare expression is a shape without bounds or exact test.
 """
@@ -23,7 +26,8 @@ import numpy as np
 
 from .expr import Expr
 
-__all__ = ["Shape", "EMPTY", "FULL", "AMBIGUOUS", "as_shape", "ExprShape"]
+__all__ = ["Shape", "EMPTY", "FULL", "AMBIGUOUS", "as_shape", "ExprShape", "exact_classifier",
+           "voxel_classifier"]
 
 #: octant states
 EMPTY, FULL, AMBIGUOUS = 0, 1, 2
@@ -61,3 +65,10 @@ def exact_classifier(shape: Any) -> Optional[Callable[[np.ndarray, np.ndarray], 
     """The shape's exact box test, if it has one."""
     test = getattr(shape, "classify_boxes", None)
     return test if callable(test) else None
+
+
+def voxel_classifier(shape: Any) -> Optional[Callable[[np.ndarray, np.ndarray], np.ndarray]]:
+    """The shape's exact test at the voxel level (``classify_voxels``, else
+    ``classify_boxes``), if it has one."""
+    test = getattr(shape, "classify_voxels", None)
+    return test if callable(test) else exact_classifier(shape)

@@ -180,7 +180,7 @@ class _Progress:
 
 def subdivide(func: Function, grid: Grid, *, start: Optional[tuple[int, np.ndarray]] = None,
               interior: bool = False, exact=None, progress=None, chunk: int = CHUNK,
-              mean_value: bool = False) -> Subdivision:
+              mean_value: bool = False, exact_voxels=None) -> Subdivision:
     """Classify octants from the root (or from ``start``) down to the voxels.
 
     Parameters
@@ -196,6 +196,9 @@ def subdivide(func: Function, grid: Grid, *, start: Optional[tuple[int, np.ndarr
         Record FULL octants.
     exact : callable, optional
         The shape's exact box test, applied to interval-AMBIGUOUS octants.
+    exact_voxels : callable, optional
+        Its form for the target depth (default: ``exact``), which must decide
+        every box (see :func:`implicitvox.shape.voxel_classifier`).
     progress : callable, optional
         Called with the estimated share of work done, in [0, 1].
     chunk : int
@@ -205,13 +208,15 @@ def subdivide(func: Function, grid: Grid, *, start: Optional[tuple[int, np.ndarr
     """
     depth = grid.depth
     per_step = max(1, chunk // 8)
+    if exact_voxels is None:
+        exact_voxels = exact
     surface: list[np.ndarray] = []
     interior_parts: dict[int, list[np.ndarray]] = {}
     stack: list[tuple[int, np.ndarray]] = []
     evaluated = 0
     if start is None:
         root = np.zeros((1, 3), dtype=np.int32)
-        state = classify(func, grid, 0, root, exact, mean_value)
+        state = classify(func, grid, 0, root, exact_voxels if depth == 0 else exact, mean_value)
         evaluated = 1
         if state[0] == FULL and interior:
             interior_parts[0] = [root]
@@ -227,7 +232,8 @@ def subdivide(func: Function, grid: Grid, *, start: Optional[tuple[int, np.ndarr
     meter = _Progress(progress, depth)
     while stack:
         level, parents = stack.pop()
-        kids, state = classify_children(func, grid, level, parents, exact, mean_value)
+        kids, state = classify_children(func, grid, level, parents,
+                                        exact_voxels if level + 1 == depth else exact, mean_value)
         evaluated += len(kids)
         meter.done += len(kids)
         if interior:

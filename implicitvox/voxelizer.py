@@ -20,7 +20,7 @@ from . import morton
 from .function import Function
 from .grid import Grid
 from .octree import Octree
-from .shape import as_shape, exact_classifier
+from .shape import as_shape, exact_classifier, voxel_classifier
 from .subdivide import subdivide
 from .voxels import Voxels
 
@@ -165,7 +165,8 @@ def voxelize(shape: Any, bounds: Any = None, resolution: Union[int, tuple[int, i
 
 def _run(shape, func, grid, options, progress, start, interior_before, estimated_voxels=None):
     t0 = time.perf_counter()
-    result = _subdivide(func, grid, options, exact_classifier(shape), progress, start)
+    result = _subdivide(func, grid, options, (exact_classifier(shape), voxel_classifier(shape)),
+                        progress, start)
     t1 = time.perf_counter()
     payload = {}
     if options["normals"]:
@@ -188,9 +189,10 @@ def _run(shape, func, grid, options, progress, start, interior_before, estimated
 def _subdivide(func, grid, options, exact, progress, start):
     """Subdivide on the grid, or on a finer one mapped back (``subvoxel``)."""
     s = options["subvoxel"]
+    exact_boxes, exact_voxels = exact
     result = subdivide(func, grid.finer(s) if s else grid, start=start,
-                       interior=options["interior"], exact=exact, progress=progress,
-                       mean_value=options["mean_value"])
+                       interior=options["interior"], exact=exact_boxes, progress=progress,
+                       mean_value=options["mean_value"], exact_voxels=exact_voxels)
     if not s:
         return result
     result.surface = np.unique(result.surface >> s, axis=0).astype(np.int32)
