@@ -10,7 +10,8 @@ leaf classifies boxes as EMPTY, FULL or AMBIGUOUS:
   (:class:`implicitvox.tribox.Triangles`), else FULL or EMPTY by the winding
   number at the box's centre;
 * boxes, convex polyhedra, half-spaces, spheres and ellipsoids (under any
-  affine map), capped cylinders and cones (under similarities) by their max-norm
+  affine map), capped cylinders and cones (under similarities), tori (under
+  similarities that keep their axis along x, y or z) by their max-norm
   distance (Varadhan §5.1, :mod:`implicitvox.linf`): AMBIGUOUS iff the
   surface meets the box (up to rounding at exact ties);
 * a function by its interval enclosure (sound; AMBIGUOUS may be a near miss).
@@ -56,8 +57,8 @@ _HALF = np.array([[(k >> a) & 1 for a in range(3)] for k in range(8)], dtype=boo
 
 def _exact_types():
     from .primitives import (Box, ConvexPolyhedron, Cylinder, Ellipsoid, HalfSpace, Polyhedron,
-                             Sphere)
-    return (Polyhedron, Box, ConvexPolyhedron, HalfSpace, Sphere, Ellipsoid, Cylinder)
+                             Sphere, Torus)
+    return (Polyhedron, Box, ConvexPolyhedron, HalfSpace, Sphere, Ellipsoid, Cylinder, Torus)
 
 
 def _has_mesh(solid) -> bool:
@@ -77,7 +78,7 @@ def _similarity_scale(m: np.ndarray) -> Optional[float]:
 def _linf_leaf(solid, matrix: np.ndarray):
     """The leaf as a max-norm primitive in world space (implicitvox.linf), or None."""
     from implicitvox import linf
-    from .primitives import Box, ConvexPolyhedron, Cylinder, Ellipsoid, HalfSpace, Sphere
+    from .primitives import Box, ConvexPolyhedron, Cylinder, Ellipsoid, HalfSpace, Sphere, Torus
     m, t = matrix[:3, :3], matrix[:3, 3]
     if isinstance(solid, Box):
         lo, hi = (np.asarray(b) for b in solid.bounds)
@@ -102,6 +103,11 @@ def _linf_leaf(solid, matrix: np.ndarray):
             z0, _ = solid._z
             return linf.Frustum(m @ np.array([0.0, 0.0, z0]) + t, m[:, 2], solid.h * k,
                                 solid.r1 * k, solid.r2 * k)
+    if isinstance(solid, Torus):
+        axis = m[:, 2] / np.linalg.norm(m[:, 2])
+        if k is not None and np.allclose(np.abs(axis), np.eye(3)[np.argmax(np.abs(axis))],
+                                         rtol=0, atol=1e-12):
+            return linf.Torus(t, axis, solid.R * k, solid.r * k)
     return None
 
 

@@ -216,34 +216,45 @@ def i_log(alo, ahi):
 
 
 # -- trigonometry -------------------------------------------------------------------
-def _holds_phase(u_lo, u_hi, slack, phase: float):
-    """Does ``[u_lo, u_hi]`` (in periods) hold a point ``u`` with ``u - phase`` an integer?
+def _holds_phase(q_lo, q_hi, phase: float):
+    """Does ``[q_lo, q_hi]`` (in periods, already widened by the slack of
+    :func:`_in_periods`) hold a point ``u`` with ``u - phase`` an integer?
 
-    Conservative: ``slack`` covers the rounding of the conversion to periods,
+    Conservative: the slack covers the rounding of the conversion to periods,
     so a point just outside may count as inside (a wider, still valid
     interval), never the reverse. Beyond about 1e12 periods from 0 the slack
     exceeds one period and every interval holds every phase.
     """
-    return np.floor(u_hi - phase + slack) >= np.ceil(u_lo - phase - slack)
+    return ~(np.floor(q_hi - phase) < np.ceil(q_lo - phase))   # NaN (inf - inf): held
 
 
 def _in_periods(alo, ahi, period: float):
+    """``[alo, ahi]`` in periods, widened by a slack of ``1e-12 (1 + |u|)`` periods
+    (an infinite end gives an infinite slack: every phase is held)."""
     u_lo = alo * (1.0 / period)
     u_hi = ahi * (1.0 / period)
-    slack = 1e-12 * (1.0 + np.maximum(np.abs(u_lo), np.abs(u_hi)))
-    with np.errstate(invalid="ignore"):
-        slack = np.where(np.isfinite(slack), slack, np.inf)  # an infinite end holds all
-    return u_lo, u_hi, slack
+    slack = np.maximum(-u_lo, u_hi)        # the larger |u| (u_lo <= u_hi)
+    slack *= 1e-12
+    slack += 1e-12
+    return u_lo - slack, u_hi + slack
+
+
+#: absolute widening of a value in [-1, 1] by TRANSCENDENTAL_ULPS floats at 1 (the
+#: largest ulp there), so at least that many ulps of the value, whatever it is
+_UNIT_WIDEN = T * R.EPS
 
 
 def _periodic(alo, ahi, f, max_phase: float, min_phase: float):
     with np.errstate(invalid="ignore"):
         fa, fb = f(alo), f(ahi)
-        u_lo, u_hi, slack = _in_periods(alo, ahi, _TWO_PI)
-        has_max = _holds_phase(u_lo, u_hi, slack, max_phase)
-        has_min = _holds_phase(u_lo, u_hi, slack, min_phase)
-    lo = R.down(np.fmin(fa, fb), T)
-    hi = R.up(np.fmax(fa, fb), T)
+        q_lo, q_hi = _in_periods(alo, ahi, _TWO_PI)
+        has_max = _holds_phase(q_lo, q_hi, max_phase)
+        has_min = _holds_phase(q_lo, q_hi, min_phase)
+    # sin and cos lie in [-1, 1]: widen by an absolute T ulps of 1, then clamp
+    lo = np.fmin(fa, fb)
+    lo -= _UNIT_WIDEN
+    hi = np.fmax(fa, fb)
+    hi += _UNIT_WIDEN
     hi = np.where(has_max, 1.0, np.minimum(hi, 1.0))
     lo = np.where(has_min, -1.0, np.maximum(lo, -1.0))
     # sin(inf) is NaN: an infinite endpoint made the slack infinite, so both are held.

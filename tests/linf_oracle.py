@@ -98,3 +98,48 @@ def frustum_support(base: np.ndarray, axis: np.ndarray, height: float, r1: float
         across = np.sqrt(np.einsum("...i,...i->...", perp, perp))
         return np.maximum(u @ base + r1 * across, u @ top + r2 * across)
     return h
+
+
+def torus_surface_distance(center: np.ndarray, axis: int, R: float, r: float, p: np.ndarray,
+                           w: np.ndarray, nu: int = 256, nv: int = 128, basins: int = 6,
+                           cells: float = 3.0, iterations: int = 56,
+                           chunk: int = 64) -> np.ndarray:
+    """``min ||p - q||_w`` over the torus surface ``q(u, v)`` (axis along ``axis``): a dense
+    ``nu x nv`` sampling of the parameters, then nested golden sections (``u`` outside,
+    ``v`` inside) over ``cells`` grid cells around each of the ``basins`` best samples
+    that are local minima of the sampling. Unsigned."""
+    order = [a for a in range(3) if a != axis] + [axis]
+    q = (p - center)[:, order]
+    ww = w[:, order]
+    du, dv = 2 * np.pi / nu, 2 * np.pi / nv
+    U, V = np.meshgrid(np.arange(nu) * du, np.arange(nv) * dv, indexing="ij")
+
+    def cost(Q, W, u, v):
+        ring = R + r * np.cos(v)
+        return np.maximum(np.maximum(np.abs(Q[..., 0] - ring * np.cos(u)) / W[..., 0],
+                                     np.abs(Q[..., 1] - ring * np.sin(u)) / W[..., 1]),
+                          np.abs(Q[..., 2] - r * np.sin(v)) / W[..., 2])
+
+    best = np.empty(len(p))
+    seeds = np.empty((len(p), basins), dtype=np.int64)
+    for s in range(0, len(p), chunk):
+        f = cost(q[s:s + chunk, None, None, :], ww[s:s + chunk, None, None, :], U[None], V[None])
+        local = np.ones(f.shape, dtype=bool)             # local minima of the periodic grid
+        for ax in (1, 2):
+            for shift in (1, -1):
+                local &= f <= np.roll(f, shift, axis=ax)
+        flat = f.reshape(len(f), -1)
+        best[s:s + chunk] = flat.min(axis=1)
+        seeds[s:s + chunk] = np.argsort(np.where(local.reshape(len(f), -1), flat, np.inf),
+                                        axis=1)[:, :basins]
+    # refine every (point, basin) at once
+    Q = np.repeat(q, basins, axis=0)
+    W = np.repeat(ww, basins, axis=0)
+    iu, iv = np.divmod(seeds.reshape(-1), nv)
+    u0, v0 = iu * du, iv * dv
+
+    def inner(u):
+        return -_golden_max(lambda v: -cost(Q, W, u, v), v0 - cells * dv, v0 + cells * dv,
+                            iterations)
+    value = -_golden_max(lambda u: -inner(u), u0 - cells * du, u0 + cells * du, iterations)
+    return np.minimum(best, value.reshape(len(p), basins).min(axis=1))

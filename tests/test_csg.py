@@ -109,10 +109,13 @@ def test_polyhedron_classification_is_exact():
 
 
 def test_which_solids_have_an_exact_test():
-    assert Torus(1, 0.2).classify_boxes is None
     assert csg.ExprSolid(ivx.x ** 2 - 1).classify_boxes is None
+    assert Blobby([(0, 0, 0), (1, 0, 0)], radius=0.5).classify_boxes is None
     assert Sphere(1).classify_boxes is not None               # max-norm distance
-    assert (Torus(1, 0.2) - Polyhedron(SPHERE_MESH)).classify_boxes is not None
+    assert Torus(1, 0.2).rotate((0, 1, 0), 90).classify_boxes is not None
+    assert (csg.ExprSolid(ivx.x ** 2 - 1) - Polyhedron(SPHERE_MESH)).classify_boxes is not None
+    from csg.classify import world_linf
+    assert world_linf(Torus(1, 0.2).rotate((1, 1, 0), 30)) is None   # general orientation
 
 
 def test_exact_leaves_settle_boxes_intervals_cannot():

@@ -8,7 +8,8 @@ from scipy.optimize import linprog
 import implicitvox as ivx
 from implicitvox import linf
 from implicitvox.shape import AMBIGUOUS, EMPTY, FULL
-from tests.linf_oracle import corner_depth, dual_distance, ellipsoid_support, frustum_support
+from tests.linf_oracle import (corner_depth, dual_distance, ellipsoid_support, frustum_support,
+                                torus_surface_distance)
 
 CUBE = np.array([[x, y, z] for x in (0, 1) for y in (0, 1) for z in (0, 1)], dtype=float)
 
@@ -362,3 +363,128 @@ def test_voxelizing_a_rotated_cylinder_gives_exactly_the_voxels_it_meets():
             assert got[k] == (r.fun <= cyl.r1 ** 2), (k, r.fun)
             checked += 1
     assert checked > 500
+
+
+# -- the torus (axis along x, y or z) ------------------------------------------------------
+@pytest.mark.parametrize("axis, n", [("y", 10_000), ("x", 2000), ("z", 2000)])
+def test_torus_matches_brute_force(axis, n):
+    """Points spread around, near the surface (1e-9 to 1e-1 away), on the axis, in the
+    equatorial plane, near the inner and outer equators and the top and bottom circles
+    (where the surface's normal is along the axis: degenerate contacts), with weights.
+    Brute force: the max-norm distance to a dense sampling of the surface parameters,
+    refined by nested golden sections (tests.linf_oracle). Any surface point bounds the
+    distance from above, so the distance may never exceed the oracle; where the oracle
+    is larger (its refinement can stall where the norm has a kink), SLSQP from 72 starts
+    over the surface parameters must agree to 1e-9."""
+    rng = np.random.default_rng(ord(axis))
+    tor = linf.Torus((0.1, -0.2, 0.3), axis, 1.0, 0.3)
+    k = tor.axis
+    others = [a for a in range(3) if a != k]
+    ang = rng.uniform(0, 2 * np.pi, (n, 1))
+    ring = np.zeros((n, 3))
+    ring[:, others[0]], ring[:, others[1]] = np.cos(ang[:, 0]), np.sin(ang[:, 0])
+    along = np.zeros(3)
+    along[k] = 1.0
+    circles = np.concatenate([tor.center + 1.3 * ring[: n // 5], tor.center + 0.7 * ring[: n // 5],
+                              tor.center + ring[: n // 5] + 0.3 * along,
+                              tor.center + ring[: n // 5] - 0.3 * along])
+    p = np.concatenate([tor.center + rng.uniform(-1.5, 1.5, (n // 2, 3)),
+                        tor.center + rng.uniform(-0.5, 0.5, (n // 10, 1)) * along,
+                        tor.center + rng.uniform(0.0, 1.5, (n // 10, 1)) * ring[: n // 10],
+                        near_surface(rng, circles, n // 5, 1.0)])
+    p = np.concatenate([p, tor.center + rng.uniform(-1.5, 1.5, (n - len(p), 3))])
+    w = rng.uniform(0.5, 2, (n, 3))
+    d = tor.distance(p, w)
+    q = p - tor.center
+    rho = np.hypot(q[:, others[0]], q[:, others[1]])
+    assert np.array_equal(d < 0, np.hypot(rho - 1.0, q[:, k]) < 0.3)     # the sign
+    oracle = torus_surface_distance(tor.center, k, tor.R, tor.r, p, w)
+    tol = 1e-9 * np.abs(d) + 1e-12
+    assert np.all(np.abs(d) <= oracle + tol)               # never above a surface point
+    again = np.flatnonzero(oracle - np.abs(d) > tol)
+    assert len(again) <= 0.01 * n
+    for i in again:
+        assert abs(d[i]) == pytest.approx(_torus_slsqp(tor, p[i], w[i]), rel=1e-9, abs=1e-12)
+
+
+def _torus_slsqp(tor, p, w):
+    """min s over (u, v, s) with |p - q(u, v)| <= s w, from 72 starts; feasible ends only."""
+    from scipy.optimize import minimize
+    order = [a for a in range(3) if a != tor.axis] + [tor.axis]
+    q, ww = (p - tor.center)[order], w[order]
+
+    def surface(uv):
+        ring = tor.R + tor.r * np.cos(uv[1])
+        return np.array([ring * np.cos(uv[0]), ring * np.sin(uv[0]), tor.r * np.sin(uv[1])])
+    cons = [{"type": "ineq", "fun": lambda x: x[2] * ww - (q - surface(x[:2]))},
+            {"type": "ineq", "fun": lambda x: x[2] * ww + (q - surface(x[:2]))}]
+    best = np.inf
+    for u0 in np.linspace(0, 2 * np.pi, 12, endpoint=False):
+        for v0 in np.linspace(0, 2 * np.pi, 6, endpoint=False):
+            r = minimize(lambda x: x[2], np.r_[u0, v0, 3.0], constraints=cons, method="SLSQP",
+                         options={"ftol": 1e-16, "maxiter": 500})
+            if np.max(np.abs(q - surface(r.x[:2])) - r.x[2] * ww) < 1e-13:
+                best = min(best, r.x[2])
+    return best
+
+
+def test_torus_errors_and_voxels():
+    with pytest.raises(ValueError, match="parallel to x, y or z"):
+        linf.Torus((0, 0, 0), (1, 1, 0), 1.0, 0.2)
+    with pytest.raises(ValueError, match="positive"):
+        linf.Torus((0, 0, 0), "z", 1.0, -0.2)
+    with pytest.raises(ValueError, match="axis"):
+        linf.Torus((0, 0, 0), "w", 1.0, 0.2)
+
+
+def _circle_box_distance(R, lo, hi, n=2048, basins=3):
+    """Euclidean distance from the circle of radius R about the z axis (z = 0) to boxes:
+    a dense sweep of the circle, refined by golden sections around its best minima."""
+    u = np.arange(n) * (2 * np.pi / n)
+
+    def dist(uu):
+        c = np.stack([R * np.cos(uu), R * np.sin(uu), np.zeros_like(uu)], -1)
+        return np.linalg.norm(c - np.clip(c, lo[:, None] if np.ndim(uu) == 2 else lo,
+                                          hi[:, None] if np.ndim(uu) == 2 else hi), axis=-1)
+    f = dist(np.broadcast_to(u, (len(lo), n)))
+    local = (f <= np.roll(f, 1, axis=1)) & (f <= np.roll(f, -1, axis=1))
+    picks = np.argsort(np.where(local, f, np.inf), axis=1)[:, :basins]
+    best = f.min(axis=1)
+    from tests.linf_oracle import _golden_max
+    for b in range(basins):
+        u0 = u[picks[:, b]]
+        best = np.minimum(best, -_golden_max(lambda t: -dist(t), u0 - 2 * np.pi / n,
+                                             u0 + 2 * np.pi / n, 60))
+    return best
+
+
+def test_voxelizing_a_torus_gives_exactly_the_voxels_it_meets():
+    """A torus turned onto the y axis, at 48^3: a voxel meets the surface iff its distance
+    to the core circle is at most r (sweep of the circle, tests above) and its farthest
+    point is beyond r (its 8 corners and the point nearest the axis: the distance to the
+    circle grows away from the circle's plane and is largest at the box's extremes in
+    rho). Checked where neither quantity is within 1e-9 of r (ties)."""
+    import csg
+    solid = csg.Torus(0.8, 0.25).rotate((1, 0, 0), 90).translate((0.013, -0.021, 0.017))
+    vox = solid.voxelize(48)
+    g = vox.grid
+    every = np.stack(np.meshgrid(*[np.arange(k) for k in g.shape], indexing="ij"),
+                     -1).reshape(-1, 3)
+    lo = np.stack([g.edge(a, every[:, a]) for a in range(3)], 1)
+    hi = np.stack([g.edge(a, every[:, a] + 1) for a in range(3)], 1)
+    c = np.array([0.013, -0.021, 0.017])
+    perm = [0, 2, 1]                       # the torus axis (y) last: local (x, z, y)
+    llo, lhi = (lo - c)[:, perm], (hi - c)[:, perm]
+    near = _circle_box_distance(0.8, llo, lhi)
+    corners = llo[:, None, :] + CUBE[None] * (lhi - llo)[:, None, :]
+    rho_c = np.hypot(corners[..., 0], corners[..., 1])
+    far_sq = np.max((rho_c - 0.8) ** 2, axis=1)
+    nearest = np.clip(0.0, llo[:, :2], lhi[:, :2])
+    rho_n = np.hypot(nearest[:, 0], nearest[:, 1])
+    far_sq = np.maximum(far_sq, (rho_n - 0.8) ** 2)
+    far = np.sqrt(far_sq + np.max(np.abs(np.stack([llo[:, 2], lhi[:, 2]], 1)), axis=1) ** 2)
+    truth = (near <= 0.25) & (far >= 0.25)
+    sure = (np.abs(near - 0.25) > 1e-9) & (np.abs(far - 0.25) > 1e-9)
+    got = vox.contains(every)
+    assert np.array_equal(got[sure], truth[sure])
+    assert sure.mean() > 0.999 and truth.sum() > 5000

@@ -14,7 +14,11 @@ the surface meets the closed box - exactly, up to rounding at ties
 * :func:`triangle_distance` and :class:`TriangleMesh` (culling by upper and
   lower bounds) - §3.3, §4.1.
 
-Not yet here: general (non-ellipsoidal) quadrics and the torus.
+* the :class:`Torus` with its axis along x, y or z (any centre): its
+  symmetry reduces the distance to a monotone function of one variable.
+
+Not yet here: general (non-ellipsoidal) quadrics and the torus in general
+orientation.
 
 Examples
 --------
@@ -35,9 +39,10 @@ from .polytope import ConvexPolytope, HalfSpace, triangle_distance
 from .sphere import Sphere
 from .ellipsoid import Ellipsoid
 from .cylinder import Cylinder, Frustum
+from .torus import Torus
 
 __all__ = ["linf_distance", "HalfSpace", "ConvexPolytope", "Sphere", "Ellipsoid", "Cylinder", "Frustum",
-           "TriangleMesh",
+           "Torus", "TriangleMesh",
            "triangle_distance", "classify_by_distance"]
 
 
@@ -48,11 +53,12 @@ def linf_distance(shape: Any, points: Any, weights: Any = None) -> np.ndarray:
     ``linf_distance(points, weights)`` method (as :mod:`csg` solids with
     exact leaves have).
     """
-    if isinstance(shape, (HalfSpace, ConvexPolytope, Sphere, Ellipsoid, Frustum, TriangleMesh)):
+    if isinstance(shape, (HalfSpace, ConvexPolytope, Sphere, Ellipsoid, Frustum, Torus,
+                          TriangleMesh)):
         return shape.distance(points, weights)
     method = getattr(shape, "linf_distance", None)
     if callable(method):
         return method(points, weights)
     raise TypeError(f"no max-norm distance for {type(shape).__name__}: use a primitive of "
                     "implicitvox.linf (HalfSpace, ConvexPolytope, Sphere, Ellipsoid, Cylinder, "
-                    "Frustum, TriangleMesh)")
+                    "Frustum, Torus, TriangleMesh)")
