@@ -143,3 +143,54 @@ def torus_surface_distance(center: np.ndarray, axis: int, R: float, r: float, p:
                             iterations)
     value = -_golden_max(lambda u: -inner(u), u0 - cells * du, u0 + cells * du, iterations)
     return np.minimum(best, value.reshape(len(p), basins).min(axis=1))
+
+
+def quadric_box_range(A: np.ndarray, b: np.ndarray, c: float, lo: np.ndarray, hi: np.ndarray):
+    """Exact least and greatest values of ``x^T A x + b.x + c`` over boxes ``[lo, hi]``.
+
+    The extremes of a quadratic over a box are at stationary points of its
+    restriction to one of the box's 27 faces (each coordinate at its low end,
+    its high end, or free); a face whose restricted Hessian is singular has its
+    extremes on its own boundary, a smaller face. So: every face, its
+    stationary point if it lies on the face, and the least and greatest value.
+    """
+    import itertools
+    n = len(lo)
+    vmin, vmax = np.full(n, np.inf), np.full(n, -np.inf)
+    for pattern in itertools.product((-1, 0, 1), repeat=3):
+        free = [a for a in range(3) if pattern[a] == 0]
+        fixed = [a for a in range(3) if pattern[a] != 0]
+        x = np.empty((n, 3))
+        for a in fixed:
+            x[:, a] = lo[:, a] if pattern[a] < 0 else hi[:, a]
+        ok = np.ones(n, dtype=bool)
+        if free:
+            M = A[np.ix_(free, free)]
+            if abs(np.linalg.det(M)) <= 1e-14 * (1 + np.abs(M).max()) ** len(free):
+                continue
+            rhs = -0.5 * b[free] - (x[:, fixed] @ A[np.ix_(free, fixed)].T if fixed else 0.0)
+            x[:, free] = np.broadcast_to(rhs, (n, len(free))) @ np.linalg.inv(M).T
+            ok = np.all((x[:, free] >= lo[:, free]) & (x[:, free] <= hi[:, free]), axis=1)
+        v = np.einsum("ni,ij,nj->n", x, A, x) + x @ b + c
+        vmin = np.where(ok, np.minimum(vmin, v), vmin)
+        vmax = np.where(ok, np.maximum(vmax, v), vmax)
+    return vmin, vmax
+
+
+def quadric_distance(A, b, c, p, w, t_max: float = 1e3) -> np.ndarray:
+    """Unsigned max-norm distance to the surface ``Q = 0`` by bisection (on float bits)
+    on the box size: the box meets the surface iff its least value of ``Q`` is
+    ``<= 0 <=`` its greatest (``Q`` is continuous, the box connected)."""
+    lo_bits = np.zeros(len(p), dtype=np.int64)
+    hi_bits = np.full(len(p), t_max).view(np.int64).copy()
+    for _ in range(64):
+        mid = lo_bits + (hi_bits - lo_bits) // 2
+        t = mid.view(np.float64)[:, None]
+        vmin, vmax = quadric_box_range(A, b, c, p - t * w, p + t * w)
+        meets = (vmin <= 0) & (vmax >= 0)
+        active = hi_bits - lo_bits > 1
+        hi_bits = np.where(active & meets, mid, hi_bits)
+        lo_bits = np.where(active & ~meets, mid, lo_bits)
+    t0 = lo_bits.view(np.float64)
+    vmin, vmax = quadric_box_range(A, b, c, p - t0[:, None] * w, p + t0[:, None] * w)
+    return np.where((vmin <= 0) & (vmax >= 0), t0, hi_bits.view(np.float64))

@@ -9,7 +9,7 @@ import implicitvox as ivx
 from implicitvox import linf
 from implicitvox.shape import AMBIGUOUS, EMPTY, FULL
 from tests.linf_oracle import (corner_depth, dual_distance, ellipsoid_support, frustum_support,
-                                torus_surface_distance)
+                                quadric_box_range, quadric_distance, torus_surface_distance)
 
 CUBE = np.array([[x, y, z] for x in (0, 1) for y in (0, 1) for z in (0, 1)], dtype=float)
 
@@ -488,3 +488,100 @@ def test_voxelizing_a_torus_gives_exactly_the_voxels_it_meets():
     got = vox.contains(every)
     assert np.array_equal(got[sure], truth[sure])
     assert sure.mean() > 0.999 and truth.sum() > 5000
+
+
+# -- general quadrics ----------------------------------------------------------------------
+QUADRICS = {"hyperboloid of one sheet": (np.diag([1.0, 2.0, -0.5]), np.zeros(3), -0.3),
+            "hyperboloid of two sheets": (np.diag([-1.0, 2.0, -0.5]), np.zeros(3), 0.3),
+            "elliptic paraboloid": (np.diag([1.0, 0.5, 0.0]), np.array([0, 0, -1.0]), 0.0),
+            "cone": (np.diag([1.0, 1.0, -0.7]), np.zeros(3), 0.0),
+            "infinite cylinder": (np.diag([1.0, 1.0, 0.0]), np.zeros(3), -0.4),
+            "two planes": (np.diag([1.0, 0.0, 0.0]), np.zeros(3), -0.2),
+            "saddle": (np.array([[0, 1.0, 0], [1.0, 0, 0], [0, 0, 0]]), np.array([0, 0, -1.0]),
+                       0.0)}
+
+
+def _on_quadric(Q, p, steps=60):
+    """Points moved onto Q = 0 by Newton steps along the gradient (those that converge)."""
+    for _ in range(steps):
+        g = 2 * p @ Q.A + Q.b
+        gg = np.sum(g * g, axis=1)
+        p = p - (Q.value(p) / np.where(gg > 0, gg, 1.0))[:, None] * g
+    return p[np.abs(Q.value(p)) < 1e-12]
+
+
+@pytest.mark.parametrize("name", list(QUADRICS))
+@pytest.mark.parametrize("turned", [False, True])
+def test_quadric_matches_brute_force_on_ten_thousand_points(name, turned):
+    """Points spread around, near the surface (1e-9 to 1e-1 away), on the local axes (the
+    degenerate cases: cone apex, axis of a cylinder, the saddle's lines), against an
+    independent brute force: bisection on the box size with the exact least and
+    greatest value of Q over a box (all 27 faces' stationary points)."""
+    rng = np.random.default_rng(len(name) + 7 * turned)
+    A, b, c = QUADRICS[name]
+    rotation = _rotation(rng) if turned else None
+    Q = linf.Quadric.from_local(A, b, c, rotation, (0.1, -0.2, 0.05))
+    local_axes = rng.uniform(-1.5, 1.5, (1000, 1)) * np.eye(3)[rng.integers(0, 3, 1000)]
+    axes = local_axes @ (np.eye(3) if rotation is None else rotation).T + [0.1, -0.2, 0.05]
+    surface = _on_quadric(Q, rng.normal(size=(6000, 3)))
+    p = np.concatenate([rng.normal(size=(5000, 3)) * 1.2, axes,
+                        near_surface(rng, surface, 4000, 1.0)])
+    w = rng.uniform(0.5, 2, (len(p), 3))
+    d = Q.distance(p, w)
+    assert np.array_equal(d < 0, Q.value(p) < 0)
+    brute = quadric_distance(Q.A, Q.b, Q.c, p, w)
+    np.testing.assert_allclose(np.abs(d), brute, rtol=1e-9, atol=1e-12)
+
+
+def test_voxelizing_a_turned_hyperboloid_gives_exactly_the_voxels_it_meets():
+    """Oracle: a voxel meets Q = 0 iff Q's least value over it is <= 0 <= its greatest
+    (exact, by the 27 faces); checked away from ties (both ends farther than 1e-12)."""
+    rng = np.random.default_rng(11)
+    Q = linf.Quadric.from_local(np.diag([1.0, 2.0, -0.5]), np.zeros(3), -0.3, _rotation(rng),
+                                (0.03, -0.02, 0.01))
+    vox = ivx.voxelize(Q, bounds=((-1, -1, -1), (1, 1, 1)), resolution=40)
+    g = vox.grid
+    every = np.stack(np.meshgrid(*[np.arange(k) for k in g.shape], indexing="ij"),
+                     -1).reshape(-1, 3)
+    lo = np.stack([g.edge(a, every[:, a]) for a in range(3)], 1)
+    hi = np.stack([g.edge(a, every[:, a] + 1) for a in range(3)], 1)
+    vmin, vmax = quadric_box_range(Q.A, Q.b, Q.c, lo, hi)
+    truth = (vmin <= 0) & (vmax >= 0)
+    sure = (np.abs(vmin) > 1e-12) & (np.abs(vmax) > 1e-12)
+    got = vox.contains(every)
+    assert np.array_equal(got[sure], truth[sure])
+    assert sure.mean() > 0.999 and truth.sum() > 3000
+
+
+def test_quadric_errors():
+    with pytest.raises(ValueError, match="symmetric"):
+        linf.Quadric([[1, 2, 0], [0, 1, 0], [0, 0, 1]], [0, 0, 0], -1)
+    with pytest.raises(ValueError, match="no surface"):
+        linf.Quadric(np.zeros((3, 3)), [0, 0, 0], 1)
+    with pytest.raises(ValueError, match="orthonormal"):
+        linf.Quadric.from_local(np.eye(3), [0, 0, 0], -1, rotation=2 * np.eye(3))
+
+
+@pytest.mark.parametrize("name", ["hyperboloid of one sheet", "cone", "saddle", "ellipsoid"])
+def test_quadric_classification_on_a_million_boxes(name):
+    """classify_boxes against the exact range of Q over each box; a disagreement only
+    where an end of the range is within 1e-12 of 0 (a tie). The ellipsoid is
+    linf.Ellipsoid's own test, checked against its quadric."""
+    rng = np.random.default_rng(5)
+    rotation = _rotation(rng)
+    if name == "ellipsoid":
+        radii = np.array([1.2, 0.7, 0.4])
+        prim = linf.Ellipsoid((0.1, -0.2, 0.05), radii, rotation)
+        Q = linf.Quadric.from_local(np.diag(radii ** -2.0), np.zeros(3), -1.0, rotation,
+                                    (0.1, -0.2, 0.05))
+    else:
+        A, b, c = QUADRICS[name]
+        prim = Q = linf.Quadric.from_local(A, b, c, rotation, (0.1, -0.2, 0.05))
+    lo = rng.uniform(-1.5, 1.5, (10**6, 3))
+    hi = lo + rng.uniform(1e-3, 0.5, (10**6, 3))
+    got = prim.classify_boxes(lo, hi)
+    vmin, vmax = quadric_box_range(Q.A, Q.b, Q.c, lo, hi)
+    want = np.where(vmin > 0, EMPTY, np.where(vmax < 0, FULL, AMBIGUOUS))
+    bad = got != want
+    assert np.all(np.minimum(np.abs(vmin), np.abs(vmax))[bad] < 1e-12)
+    assert (want == AMBIGUOUS).sum() > 10**5

@@ -14,11 +14,12 @@ the surface meets the closed box - exactly, up to rounding at ties
 * :func:`triangle_distance` and :class:`TriangleMesh` (culling by upper and
   lower bounds) - §3.3, §4.1.
 
+* general quadrics ``x^T A x + b.x + c <= 0`` (:class:`Quadric`:
+  hyperboloids, paraboloids, cones, cylinders, in any position) - §3.2;
 * the :class:`Torus` with its axis along x, y or z (any centre): its
   symmetry reduces the distance to a monotone function of one variable.
 
-Not yet here: general (non-ellipsoidal) quadrics and the torus in general
-orientation.
+Not yet here: the torus in general orientation.
 
 Examples
 --------
@@ -40,9 +41,10 @@ from .sphere import Sphere
 from .ellipsoid import Ellipsoid
 from .cylinder import Cylinder, Frustum
 from .torus import Torus
+from .quadric import Quadric
 
 __all__ = ["linf_distance", "HalfSpace", "ConvexPolytope", "Sphere", "Ellipsoid", "Cylinder", "Frustum",
-           "Torus", "TriangleMesh",
+           "Torus", "Quadric", "TriangleMesh",
            "triangle_distance", "classify_by_distance"]
 
 
@@ -54,11 +56,11 @@ def linf_distance(shape: Any, points: Any, weights: Any = None) -> np.ndarray:
     exact leaves have).
     """
     if isinstance(shape, (HalfSpace, ConvexPolytope, Sphere, Ellipsoid, Frustum, Torus,
-                          TriangleMesh)):
+                          Quadric, TriangleMesh)):
         return shape.distance(points, weights)
     method = getattr(shape, "linf_distance", None)
     if callable(method):
         return method(points, weights)
     raise TypeError(f"no max-norm distance for {type(shape).__name__}: use a primitive of "
                     "implicitvox.linf (HalfSpace, ConvexPolytope, Sphere, Ellipsoid, Cylinder, "
-                    "Frustum, Torus, TriangleMesh)")
+                    "Frustum, Torus, Quadric, TriangleMesh)")

@@ -49,6 +49,8 @@ def main() -> None:
          "45-50"),
         ("rotated capped cylinder", linf.Cylinder((0.1, 0.2, 0.3), q[:, 0], 1.5, 0.5), "-"),
         ("rotated cone", linf.Frustum((0.1, 0.2, 0.3), q[:, 1], 1.5, 0.6, 0.0), "-"),
+        ("rotated hyperboloid (quadric)", linf.Quadric.from_local(
+            np.diag([1.0, 2.0, -0.5]), np.zeros(3), -0.3, q, (0.1, 0.2, 0.3)), "45-50"),
         ("torus, axis along y", linf.Torus((0.1, 0.2, 0.3), "y", 1.2, 0.4), "1000-1200"),
     ]
     print(f"{'query':<30} {'µs/point':>9} {'weighted':>9} {'Varadhan µs':>12}")
