@@ -239,22 +239,14 @@ def _in_periods(alo, ahi, period: float):
     return u_lo - slack, u_hi + slack
 
 
-#: absolute widening of a value in [-1, 1] by TRANSCENDENTAL_ULPS floats at 1 (the
-#: largest ulp there), so at least that many ulps of the value, whatever it is
-_UNIT_WIDEN = T * R.EPS
-
-
 def _periodic(alo, ahi, f, max_phase: float, min_phase: float):
     with np.errstate(invalid="ignore"):
         fa, fb = f(alo), f(ahi)
         q_lo, q_hi = _in_periods(alo, ahi, _TWO_PI)
         has_max = _holds_phase(q_lo, q_hi, max_phase)
         has_min = _holds_phase(q_lo, q_hi, min_phase)
-    # sin and cos lie in [-1, 1]: widen by an absolute T ulps of 1, then clamp
-    lo = np.fmin(fa, fb)
-    lo -= _UNIT_WIDEN
-    hi = np.fmax(fa, fb)
-    hi += _UNIT_WIDEN
+    lo = R.down(np.fmin(fa, fb), T)
+    hi = R.up(np.fmax(fa, fb), T)
     hi = np.where(has_max, 1.0, np.minimum(hi, 1.0))
     lo = np.where(has_min, -1.0, np.maximum(lo, -1.0))
     # sin(inf) is NaN: an infinite endpoint made the slack infinite, so both are held.
