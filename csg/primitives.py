@@ -23,7 +23,7 @@ import numpy as np
 import implicitvox as iv
 from implicitvox import Expr, x, y, z
 
-from .solid import Bounds, Solid
+from .solid import Bounds, Solid, _vector
 
 __all__ = ["Sphere", "Box", "Cylinder", "Torus", "Ellipsoid", "HalfSpace", "ConvexPolyhedron",
            "Polyhedron"]
@@ -50,15 +50,8 @@ def _nonneg(value: Any, name: str) -> float:
 
 
 def _point(value: Any, name: str) -> np.ndarray:
-    try:
-        p = np.asarray(value, dtype=np.float64)
-    except (TypeError, ValueError):
-        raise ValueError(f"{name} must be 3 numbers, got {value!r}") from None
-    if p.shape == ():
-        p = np.full(3, float(p))
-    if p.shape != (3,) or not np.all(np.isfinite(p)):
-        raise ValueError(f"{name} must be 3 finite numbers, got {value!r}")
-    return p
+    """3 finite floats (one number fills all three)."""
+    return _vector(value, name, planar=False, scalar=True)
 
 
 def _box(lo: Sequence[float], hi: Sequence[float]) -> Bounds:

@@ -178,13 +178,17 @@ def _check_solid(other: Any, op: str) -> "Solid":
     return other
 
 
-def _vector(v: Any, name: str) -> np.ndarray:
+def _vector(v: Any, name: str, *, planar: bool = True, scalar: bool = False) -> np.ndarray:
+    """3 finite floats, or a ``ValueError`` naming ``name``; with ``planar`` 2 numbers
+    get z = 0 (transforms of 2D shapes), with ``scalar`` one number fills all three."""
     try:
         a = np.asarray(v, dtype=np.float64)
     except (TypeError, ValueError):
         raise ValueError(f"{name} must be 3 numbers, got {v!r}") from None
-    if a.shape == (2,):
+    if planar and a.shape == (2,):
         a = np.append(a, 0.0)
+    if scalar and a.shape == ():
+        a = np.full(3, float(a))
     if a.shape != (3,) or not np.all(np.isfinite(a)):
         raise ValueError(f"{name} must be 3 finite numbers, got {v!r}")
     return a

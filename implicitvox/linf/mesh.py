@@ -30,7 +30,7 @@ from typing import Any
 
 import numpy as np
 
-from .norm import as_points, as_weights
+from .norm import as_points, as_weights, in_blocks
 from .polytope import triangle_distance
 
 __all__ = ["TriangleMesh"]
@@ -87,9 +87,7 @@ class TriangleMesh:
         """Weighted max-norm distance (negative inside a closed mesh)."""
         p = as_points(points)
         w = as_weights(weights, len(p))
-        out = np.empty(len(p))
-        for s in range(0, len(p), _BLOCK):
-            out[s:s + _BLOCK] = self._unsigned(p[s:s + _BLOCK], w[s:s + _BLOCK])
+        out = in_blocks(self._unsigned, p, w, _BLOCK)
         if self.closed:
             from implicitvox.crossings import RayWinding
             if self._winding is None:

@@ -19,7 +19,7 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["as_points", "as_weights", "support"]
+__all__ = ["as_points", "as_weights", "support", "in_blocks"]
 
 
 def as_points(points: Any) -> np.ndarray:
@@ -52,3 +52,11 @@ def as_weights(weights: Any, n: int) -> np.ndarray:
 def support(u: np.ndarray, w: np.ndarray) -> np.ndarray:
     """``sum_i |u_i| w_i``: how far the box of half-widths ``w`` reaches along ``u``."""
     return np.abs(u) @ np.ones(3) if w is None else np.sum(np.abs(u) * w, axis=-1)
+
+
+def in_blocks(fn, p: np.ndarray, w: np.ndarray, size: int) -> np.ndarray:
+    """``fn(p, w)`` over blocks of ``size`` points (bounded temporaries), concatenated."""
+    out = np.empty(len(p))
+    for s in range(0, len(p), size):
+        out[s:s + size] = fn(p[s:s + size], w[s:s + size])
+    return out

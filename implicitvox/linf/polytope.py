@@ -28,7 +28,7 @@ from typing import Any, Optional
 
 import numpy as np
 
-from .norm import as_points, as_weights
+from .norm import as_points, as_weights, in_blocks
 
 __all__ = ["ConvexPolytope", "HalfSpace", "triangle_distance", "CHUNK"]
 
@@ -105,10 +105,7 @@ class ConvexPolytope:
         """Signed weighted max-norm distance (negative inside)."""
         p = as_points(points)
         w = as_weights(weights, len(p))
-        out = np.empty(len(p))
-        for s in range(0, len(p), CHUNK):
-            out[s:s + CHUNK] = self._distance(p[s:s + CHUNK], w[s:s + CHUNK])
-        return out
+        return in_blocks(self._distance, p, w, CHUNK)
 
     def _distance(self, p: np.ndarray, w: np.ndarray) -> np.ndarray:
         slack = self.offsets[None, :] - p @ self.normals.T              # (n, F), >= 0 inside
