@@ -49,27 +49,10 @@ _SIGNS = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-
 _TOL = 1e-12
 
 
-def _smallest_root(a, b, c):
-    """Least root ``t >= 0`` of ``a t^2 + b t + c`` (inf if none), stable in every regime."""
-    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-        disc = b * b - 4 * a * c
-        s = np.sqrt(disc)
-        q = -0.5 * (b + np.copysign(s, b))
-        r1, r2 = q / a, c / q
-        linear = -c / b
-    quad = (a != 0) & (disc >= 0)
-    cands = [np.where(quad, r1, np.nan), np.where(quad, r2, np.nan),
-             np.where((a == 0) & (b != 0), linear, np.nan),
-             np.where((a == 0) & (b == 0) & (c == 0), 0.0, np.nan)]
-    best = np.full(np.shape(a), np.inf)
-    for r in cands:
-        best = np.fmin(best, np.where(r >= 0, r, np.inf))
-    return best
-
-
 def _valid_root(a2, a1, a0, bounds):
     """Least ``t >= 0`` with ``a2 t^2 + a1 t + a0 = 0`` at which every
-    ``|alpha + beta t| <= t w`` (``bounds``: ``(alpha, beta, w)`` triples)."""
+    ``|alpha + beta t| <= t w`` (``bounds``: ``(alpha, beta, w)`` triples; none for a
+    vertex), stable in every regime; inf if none."""
     best = np.full(a0.shape, np.inf)
     with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
         disc = a1 * a1 - 4 * a2 * a0
@@ -151,8 +134,8 @@ class Quadric:
                 if A[i, j]:
                     a2 += (A[i, j] if i == j else 2 * s[i] * s[j] * A[i, j]) * prod
             a1 = s[0] * gw[:, 0] + s[1] * gw[:, 1] + s[2] * gw[:, 2]
-            best = np.fmin(best, _smallest_root(a2, a1, q0))
-            best = np.fmin(best, _smallest_root(a2, -a1, q0))
+            best = np.fmin(best, _valid_root(a2, a1, q0, []))
+            best = np.fmin(best, _valid_root(a2, -a1, q0, []))
         scale = 1 + np.abs(A).max()
         for k in range(3):                                     # edges along e_k
             if abs(A[k, k]) <= _TOL * scale:
