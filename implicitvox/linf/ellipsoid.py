@@ -35,9 +35,10 @@ from .norm import as_points, as_weights
 
 __all__ = ["Ellipsoid"]
 
-_SIGNS = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)],
-                  dtype=np.float64)
+#: the 8 corner rays as 4 lines through p: directions (sx, sy, 1) * w
+_LINE_SIGNS = [(sx, sy) for sx in (-1.0, 1.0) for sy in (-1.0, 1.0)]
 _EDGES = [(i, j, k) for k, (i, j) in enumerate([(1, 2), (2, 0), (0, 1)])]
+
 
 
 def _roots(A, B, C):
@@ -94,59 +95,74 @@ class Ellipsoid:
     def distance(self, points: Any, weights: Any = None) -> np.ndarray:
         p = as_points(points)
         w = as_weights(weights, len(p))
-        y = p - self.center
-        level = np.sum((y @ self.Q) * y, axis=1)
-        out = np.empty(len(p))
-        inside = level <= 1
-        out[inside] = -self._depth(y[inside], w[inside], level[inside])
-        out[~inside] = self._gap(y[~inside], w[~inside], level[~inside])
-        return out
+        y = np.ascontiguousarray((p - self.center).T)         # columns: fast row sums
+        w = np.ascontiguousarray(w.T)
+        Qy = self.Q @ y
+        level = y[0] * Qy[0] + y[1] * Qy[1] + y[2] * Qy[2]
+        C = level - 1.0
+        # Vertex contacts (outside) and corner exits (inside), 8 rays as 4 lines
+        # through p: on the line p + t d both meet-times come from one quadratic.
+        best = self._vertex_times(w, Qy, C)
+        outside = C > 0
+        if np.any(outside):
+            sub = np.flatnonzero(outside)
+            gap = np.fmin(best[sub], self._edge_and_face_times(y[:, sub], w[:, sub]))
+            best[sub] = gap
+        return np.where(outside, best, -best)
 
-    def _ray(self, y, d, level, Qy=None):
-        Qd = d @ self.Q
-        A = np.sum(Qd * d, axis=1)
-        B = np.sum(Qd * y, axis=1)
-        return _roots(A, B, level - 1)
-
-    def _depth(self, y, w, level):
-        best = np.full(len(y), np.inf)
-        for s in _SIGNS:
-            _, t2 = self._ray(y, s * w, level)
-            best = np.minimum(best, np.maximum(t2, 0.0))
+    def _vertex_times(self, w, Qy, C):
+        """Per point, the least time at which a corner ray of the growing box meets the
+        boundary: ``|C| / (|B| + sqrt(B^2 - A C))`` per line (both roots at once: the
+        ray moving towards E enters at it when outside; the nearer exit when inside)."""
+        Q = self.Q
+        w2 = w * w
+        diag = Q[0, 0] * w2[0] + Q[1, 1] * w2[1] + Q[2, 2] * w2[2]
+        c01, c02, c12 = (2 * Q[0, 1] * w[0] * w[1], 2 * Q[0, 2] * w[0] * w[2],
+                         2 * Q[1, 2] * w[1] * w[2])
+        wq = w * Qy
+        best = np.full(C.shape, np.inf)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            for sx, sy in _LINE_SIGNS:
+                A = diag + (sx * sy) * c01 + sx * c02 + sy * c12
+                B = np.abs(sx * wq[0] + sy * wq[1] + wq[2])
+                t = np.abs(C) / (B + np.sqrt(B * B - A * C))
+                best = np.fmin(best, t)
         return best
 
-    def _gap(self, y, w, level):
-        best = np.full(len(y), np.inf)
-        for s in _SIGNS:                                    # vertex contacts
-            t1, _ = self._ray(y, s * w, level)
-            best = np.fmin(best, np.where(t1 >= 0, t1, np.inf))
+    def _edge_and_face_times(self, y, w):
         Q = self.Q
-        for i, j, k in _EDGES:                              # edge contacts
-            P = Q[np.ix_([i, j], [i, j])] - np.outer(Q[[i, j], k], Q[k, [i, j]]) / Q[k, k]
-            z0 = y[:, [i, j]]
-            Pz0 = z0 @ P
-            C = np.sum(Pz0 * z0, axis=1) - 1                   # the same for the 4 edges
-            for si in (-1.0, 1.0):
-                for sj in (-1.0, 1.0):
-                    dz = np.stack([si * w[:, i], sj * w[:, j]], axis=1)
-                    A = np.sum((dz @ P) * dz, axis=1)
-                    B = np.sum(Pz0 * dz, axis=1)
-                    t1, _ = _roots(A, B, C)
-                    t1 = np.where((C > 0) & (t1 >= 0), t1, np.nan)
-                    z = z0 + t1[:, None] * dz
-                    yk = -(z @ Q[[i, j], k]) / Q[k, k]
-                    ok = np.abs(yk - y[:, k]) <= t1 * w[:, k] * (1 + 1e-12) + 1e-300
-                    best = np.fmin(best, np.where(ok, t1, np.inf))
-        half = np.sqrt(np.diag(self.Qinv))
-        for i in range(3):                                  # face contacts
-            for sigma in (-1.0, 1.0):
-                # the face with outward normal sigma e_i meets E's point extreme in -sigma e_i
-                x_star = -sigma * self.Qinv[:, i] / half[i]
-                t = sigma * (x_star[i] - y[:, i]) / w[:, i]
+        best = np.full(y.shape[1], np.inf)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            for i, j, k in _EDGES:                              # edge contacts
+                P = Q[np.ix_([i, j], [i, j])] - np.outer(Q[[i, j], k], Q[k, [i, j]]) / Q[k, k]
+                yi, yj = y[i], y[j]
+                Pz_i, Pz_j = P[0, 0] * yi + P[0, 1] * yj, P[1, 0] * yi + P[1, 1] * yj
+                C = yi * Pz_i + yj * Pz_j - 1.0             # the same for the 4 parallel edges
+                wi, wj = w[i], w[j]
+                base = P[0, 0] * wi * wi + P[1, 1] * wj * wj
+                cross = 2.0 * P[0, 1] * wi * wj
+                gi, gj = Pz_i * wi, Pz_j * wj
+                for sj in (1.0, -1.0):                      # the edge pairs (s, -s) share a line
+                    A = base + sj * cross
+                    B = gi + sj * gj
+                    t = C / (np.abs(B) + np.sqrt(B * B - A * C))
+                    toward = -np.sign(B)                    # the direction that approaches
+                    zi, zj = yi + t * toward * wi, yj + t * (toward * sj) * wj
+                    yk = -(zi * Q[i, k] + zj * Q[j, k]) / Q[k, k]
+                    ok = (C > 0) & (np.abs(yk - y[k]) <= t * w[k] * (1 + 1e-12) + 1e-300)
+                    best = np.fmin(best, np.where(ok, t, np.inf))
+            half = np.sqrt(np.diag(self.Qinv))
+            for i in range(3):                                  # face contacts
                 others = [a for a in range(3) if a != i]
-                ok = (t >= 0) & np.all(np.abs(x_star[others] - y[:, others])
-                                       <= t[:, None] * w[:, others] * (1 + 1e-12), axis=1)
-                best = np.fmin(best, np.where(ok, t, np.inf))
+                for sigma in (-1.0, 1.0):
+                    # the face with outward normal sigma e_i meets E's point extreme in -sigma e_i
+                    x_star = -sigma * self.Qinv[:, i] / half[i]
+                    t = sigma * (x_star[i] - y[i]) / w[i]
+                    slack = t * (1 + 1e-12)
+                    ok = ((t >= 0) & (np.abs(x_star[others[0]] - y[others[0]])
+                                      <= slack * w[others[0]])
+                          & (np.abs(x_star[others[1]] - y[others[1]]) <= slack * w[others[1]]))
+                    best = np.fmin(best, np.where(ok, t, np.inf))
         return best
 
     def classify_boxes(self, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
