@@ -103,10 +103,11 @@ def _linf_leaf(solid, matrix: np.ndarray):
             z0, _ = solid._z
             return linf.Frustum(m @ np.array([0.0, 0.0, z0]) + t, m[:, 2], solid.h * k,
                                 solid.r1 * k, solid.r2 * k)
-    if isinstance(solid, Torus):
+    if isinstance(solid, Torus) and k is not None:
         axis = m[:, 2] / np.linalg.norm(m[:, 2])
-        if k is not None and np.allclose(np.abs(axis), np.eye(3)[np.argmax(np.abs(axis))],
-                                         rtol=0, atol=1e-12):
+        aligned = np.allclose(np.abs(axis), np.eye(3)[np.argmax(np.abs(axis))], rtol=0,
+                              atol=1e-12)
+        if aligned or solid.R > solid.r:           # tilted: exact for ring tori only
             return linf.Torus(t, axis, solid.R * k, solid.r * k)
     return None
 

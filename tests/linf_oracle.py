@@ -100,30 +100,42 @@ def frustum_support(base: np.ndarray, axis: np.ndarray, height: float, r1: float
     return h
 
 
-def torus_surface_distance(center: np.ndarray, axis: int, R: float, r: float, p: np.ndarray,
+def torus_surface_distance(center: np.ndarray, axis, R: float, r: float, p: np.ndarray,
                            w: np.ndarray, nu: int = 256, nv: int = 128, basins: int = 6,
                            cells: float = 3.0, iterations: int = 56,
                            chunk: int = 64) -> np.ndarray:
-    """``min ||p - q||_w`` over the torus surface ``q(u, v)`` (axis along ``axis``): a dense
-    ``nu x nv`` sampling of the parameters, then nested golden sections (``u`` outside,
-    ``v`` inside) over ``cells`` grid cells around each of the ``basins`` best samples
-    that are local minima of the sampling. Unsigned."""
-    order = [a for a in range(3) if a != axis] + [axis]
-    q = (p - center)[:, order]
-    ww = w[:, order]
+    """``min ||p - q||_w`` over the torus surface ``q(u, v) = c + (R + r cos v)(cos u e1 +
+    sin u e2) + r sin v a`` (``axis`` an index 0-2 or a vector ``a``): a dense ``nu x nv``
+    sampling of the parameters, then nested golden sections (``u`` outside, ``v`` inside)
+    over ``cells`` grid cells around each of the ``basins`` best samples that are local
+    minima of the sampling. Unsigned."""
+    if np.ndim(axis) == 0:
+        a = np.eye(3)[int(axis)]
+    else:
+        a = np.asarray(axis, dtype=np.float64) / np.linalg.norm(axis)
+    helper = np.eye(3)[int(np.argmin(np.abs(a)))]
+    e1 = helper - (helper @ a) * a
+    e1 /= np.linalg.norm(e1)
+    e2 = np.cross(a, e1)
+    frame = np.stack([e1, e2, a])                       # rows
+    q = p - center
     du, dv = 2 * np.pi / nu, 2 * np.pi / nv
     U, V = np.meshgrid(np.arange(nu) * du, np.arange(nv) * dv, indexing="ij")
 
     def cost(Q, W, u, v):
         ring = R + r * np.cos(v)
-        return np.maximum(np.maximum(np.abs(Q[..., 0] - ring * np.cos(u)) / W[..., 0],
-                                     np.abs(Q[..., 1] - ring * np.sin(u)) / W[..., 1]),
-                          np.abs(Q[..., 2] - r * np.sin(v)) / W[..., 2])
+        local = (ring * np.cos(u), ring * np.sin(u), r * np.sin(v))
+        out = None
+        for i in range(3):
+            s_i = local[0] * frame[0, i] + local[1] * frame[1, i] + local[2] * frame[2, i]
+            term = np.abs(Q[..., i] - s_i) / W[..., i]
+            out = term if out is None else np.maximum(out, term)
+        return out
 
     best = np.empty(len(p))
     seeds = np.empty((len(p), basins), dtype=np.int64)
     for s in range(0, len(p), chunk):
-        f = cost(q[s:s + chunk, None, None, :], ww[s:s + chunk, None, None, :], U[None], V[None])
+        f = cost(q[s:s + chunk, None, None, :], w[s:s + chunk, None, None, :], U[None], V[None])
         local = np.ones(f.shape, dtype=bool)             # local minima of the periodic grid
         for ax in (1, 2):
             for shift in (1, -1):
@@ -134,7 +146,7 @@ def torus_surface_distance(center: np.ndarray, axis: int, R: float, r: float, p:
                                         axis=1)[:, :basins]
     # refine every (point, basin) at once
     Q = np.repeat(q, basins, axis=0)
-    W = np.repeat(ww, basins, axis=0)
+    W = np.repeat(w, basins, axis=0)
     iu, iv = np.divmod(seeds.reshape(-1), nv)
     u0, v0 = iu * du, iv * dv
 

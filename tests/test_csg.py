@@ -115,7 +115,9 @@ def test_which_solids_have_an_exact_test():
     assert Torus(1, 0.2).rotate((0, 1, 0), 90).classify_boxes is not None
     assert (csg.ExprSolid(ivx.x ** 2 - 1) - Polyhedron(SPHERE_MESH)).classify_boxes is not None
     from csg.classify import world_linf
-    assert world_linf(Torus(1, 0.2).rotate((1, 1, 0), 30)) is None   # general orientation
+    assert world_linf(Torus(1, 0.2).rotate((1, 1, 0), 30)).axis is None  # general orientation
+    assert world_linf(Torus(0.2, 0.3).rotate((1, 1, 0), 30)) is None  # tilted spindle torus
+    assert world_linf(Torus(0.2, 0.3).rotate((1, 0, 0), 90)) is not None  # upright: exact
 
 
 def test_exact_leaves_settle_boxes_intervals_cannot():

@@ -16,10 +16,11 @@ the surface meets the closed box - exactly, up to rounding at ties
 
 * general quadrics ``x^T A x + b.x + c <= 0`` (:class:`Quadric`:
   hyperboloids, paraboloids, cones, cylinders, in any position) - §3.2;
-* the :class:`Torus` with its axis along x, y or z (any centre): its
-  symmetry reduces the distance to a monotone function of one variable.
-
-Not yet here: the torus in general orientation.
+* the :class:`Torus`: with its axis along x, y or z (any centre) its
+  symmetry reduces the distance to a monotone function of one variable; in
+  general orientation (ring tori) the contact equations are solved on the
+  monotone arcs of the silhouette's offset curves
+  (:mod:`implicitvox.linf.torus_frame`).
 
 Examples
 --------

@@ -1,4 +1,8 @@
-"""Max-norm distance to a torus whose axis is parallel to a coordinate axis (Varadhan §3.2).
+"""Max-norm distance to a torus (Varadhan §3.2): exact, in any orientation.
+
+A torus in general orientation (a ring torus, ``R > r``) is solved by its
+contact equations in :mod:`implicitvox.linf.torus_frame`. When its axis is
+parallel to a coordinate axis a simpler exact method applies, described here.
 
 Varadhan et al. reduce the torus to polynomials of degree 8 "through
 symmetry". When the torus axis is parallel to a coordinate axis the symmetry
@@ -18,8 +22,7 @@ Hence, exactly:
 Both tests are monotone in ``t``, so the distance is the root of a monotone
 function of one variable: bisection on the bit patterns of ``t`` finds it to
 the last float in at most 64 steps, for every point at once, with no
-polynomial to get wrong and no root to lose. A torus in general orientation
-is not covered here.
+polynomial to get wrong and no root to lose.
 
 Examples
 --------
@@ -27,6 +30,9 @@ Examples
 >>> t = Torus((0, 0, 0), "z", R=1.0, r=0.25)
 >>> t.distance(np.array([[2.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 0.0]])).round(12).tolist()
 [0.75, -0.170492908303, 0.530330085890]
+>>> tilted = Torus((0, 0, 0), (1.0, 1.0, 0.0), R=1.0, r=0.25)
+>>> float(tilted.distance(np.array([[0.0, 0.0, 2.0]]))[0])
+0.75
 """
 from __future__ import annotations
 
@@ -36,59 +42,82 @@ import numpy as np
 
 import implicitvox as iv
 
-from .norm import as_points, as_weights
+from .norm import as_points, as_weights, in_blocks
+from .torus_frame import TorusFrame
 
 __all__ = ["Torus"]
 
 _AXES = {"x": 0, "y": 1, "z": 2}
 
 
-def _axis_index(axis: Any) -> int:
+def _unit_axis(axis: Any) -> np.ndarray:
+    """The axis as a unit vector (``'x'``, ``'y'``, ``'z'`` or any non-zero 3-vector)."""
     if isinstance(axis, str):
         if axis in _AXES:
-            return _AXES[axis]
-        raise ValueError(f"axis must be 'x', 'y', 'z' or a vector along one of them, got {axis!r}")
+            return np.eye(3)[_AXES[axis]]
+        raise ValueError(f"axis must be 'x', 'y', 'z' or a non-zero 3-vector, got {axis!r}")
     a = np.asarray(axis, dtype=np.float64).reshape(-1)
     if a.shape == (3,) and np.all(np.isfinite(a)) and np.linalg.norm(a) > 0:
-        a = a / np.linalg.norm(a)
-        k = int(np.argmax(np.abs(a)))
-        if np.allclose(np.abs(a), np.eye(3)[k], rtol=0, atol=1e-12):
-            return k
-        raise ValueError(f"axis must be parallel to x, y or z (a torus in general orientation "
-                         f"has no exact max-norm distance here yet), got {a.tolist()}")
-    raise ValueError(f"axis must be 'x', 'y', 'z' or a vector along one of them, got {axis!r}")
+        return a / np.linalg.norm(a)
+    raise ValueError(f"axis must be 'x', 'y', 'z' or a non-zero 3-vector, got {axis!r}")
+
+
+def _aligned_index(a: np.ndarray):
+    """The coordinate axis ``a`` is parallel to (within 1e-12), or None."""
+    k = int(np.argmax(np.abs(a)))
+    return k if np.allclose(np.abs(a), np.eye(3)[k], rtol=0, atol=1e-12) else None
 
 
 class Torus:
-    """Torus with ``center``, ``axis`` (``'x'``, ``'y'``, ``'z'`` or a vector along one),
-    major radius ``R`` (centre to tube centre) and minor radius ``r`` (the tube's)."""
+    """Torus with ``center``, ``axis`` (``'x'``, ``'y'``, ``'z'`` or any non-zero vector),
+    major radius ``R`` (centre to tube centre) and minor radius ``r`` (the tube's).
+
+    Off the coordinate axes the torus must be a ring torus (``R > r``): the
+    contact equations need its smooth surface."""
+
+    #: points per block in general orientation (bounded temporaries)
+    BLOCK = 2048
 
     def __init__(self, center: Any, axis: Any, R: float, r: float):
         self.center = np.asarray(center, dtype=np.float64).reshape(3)
         if not np.all(np.isfinite(self.center)):
             raise ValueError(f"center must be finite, got {self.center.tolist()}")
-        self.axis = _axis_index(axis)
+        self.unit_axis = _unit_axis(axis)
         self.R, self.r = float(R), float(r)
         if not (np.isfinite(self.R) and np.isfinite(self.r) and self.R > 0 and self.r > 0):
             raise ValueError(f"R and r must be positive and finite, got R={R!r}, r={r!r}")
-        #: the two axes across the torus axis, then the axis
-        self.order = [a for a in range(3) if a != self.axis] + [self.axis]
+        #: the coordinate axis the torus axis is parallel to, or None (general orientation)
+        self.axis = _aligned_index(self.unit_axis)
+        if self.axis is None:
+            if not self.R > self.r:
+                raise ValueError(f"a torus off the coordinate axes must be a ring torus "
+                                 f"(R > r), got R={R!r}, r={r!r}")
+            self.frame = TorusFrame(self.center, self.unit_axis, self.R, self.r)
+        else:
+            #: the two axes across the torus axis, then the axis
+            self.order = [a for a in range(3) if a != self.axis] + [self.axis]
 
     @property
     def expr(self) -> iv.Expr:
         q = [iv.x - self.center[0], iv.y - self.center[1], iv.z - self.center[2]]
-        u, v, w = (q[a] for a in self.order)
+        if self.axis is not None:
+            u, v, w = (q[a] for a in self.order)
+        else:
+            u, v, w = (sum(float(e[i]) * q[i] for i in range(3))
+                       for e in (self.frame.e1, self.frame.e2, self.frame.a))
         return iv.hypot(iv.hypot(u, v) - self.R, w) - self.r
 
     @property
     def bounds(self):
-        half = np.full(3, self.R + self.r)
-        half[self.axis] = self.r
+        across = np.sqrt(np.maximum(1.0 - self.unit_axis ** 2, 0.0))  # the core circle's extent
+        half = self.R * across + self.r
         return tuple((self.center - half).tolist()), tuple((self.center + half).tolist())
 
     def distance(self, points: Any, weights: Any = None) -> np.ndarray:
         p = as_points(points)
         w = as_weights(weights, len(p))
+        if self.axis is None:
+            return in_blocks(self.frame.distance, p, w, self.BLOCK)
         q = np.abs(p - self.center)[:, self.order]          # the torus is symmetric in each
         w = w[:, self.order]
         inside = np.hypot(np.hypot(q[:, 0], q[:, 1]) - self.R, q[:, 2]) <= self.r
