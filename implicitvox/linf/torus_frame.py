@@ -11,8 +11,10 @@ growing box ``B(p, t) = p + t [-w, w]`` first touches the surface, in the
 relative interior of a face, of an edge, or at a vertex (Varadhan §3.2). At
 the touching point, by the Lagrange conditions of ``max_i |p_i - s_i| / w_i``:
 
-* **face** (normal to ``e_k``): ``n = ±e_k`` - four fixed points per axis,
-  ``c + eps R v_k + sigma r e_k``-like, in closed form;
+* **face** (normal to ``e_k``): ``n = ±e_k`` - four fixed points per axis:
+  with ``v_k`` the unit projection of ``e_k`` across the axis
+  (``e_k = beta_k v_k + a_k a``), ``s = c + eps (R + eps sigma r beta_k) v_k +
+  sigma r a_k a`` for ``eps, sigma = ±1``;
 * **edge** (along ``e_k``): ``n_k = 0`` - the point is on the torus's
   silhouette seen along ``e_k`` - and ``s`` lies in the plane through ``p``
   that holds the edge, ``(s_i - p_i) / w_i = ±(s_j - p_j) / w_j``;
@@ -32,8 +34,9 @@ whose derivative is ``(1 ± r kappa(theta)) E'(theta)``. So
 monotone between the zeros of ``l . E'`` (two angles, closed form) and, for
 the inner offset, of ``1 - r kappa`` (the cusps: four angles, closed form,
 when ``a_k^2 <= r / R``). Each monotone arc holds at most one root, found
-by safeguarded Newton steps; the arc ends are candidates too, so a root
-within rounding of an end is never lost. When the axis lies in the plane
+by safeguarded Newton steps; an arc end where ``g`` is within rounding of
+zero is a candidate too, so a root beside a rounded critical angle is never
+lost. When the axis lies in the plane
 across ``e_k`` (``a_k = 0``) the silhouette degenerates to four circles -
 the two meridian circles in that plane and the two circles ``phi = ±pi/2``
 - met by the edge plane in closed form; near that case (``|a_k| < 1e-3``)
@@ -42,6 +45,14 @@ offset curves' parameter then resolves nothing). Tests hold both to 1e-9
 against brute force at ``a_k = 0, 1e-17, 1e-9, 3e-8``.
 
 The torus must be a ring torus (``R > r``), whose surface is smooth.
+
+Examples
+--------
+>>> import numpy as np
+>>> tor = TorusFrame(np.zeros(3), np.array([1.0, 1.0, 0.0]), 1.0, 0.25)
+>>> p = np.array([[0.0, 0.0, 2.0], [0.0, 0.0, 1.0]])     # above; on the core circle
+>>> tor.distance(p, np.ones((2, 3))).round(12).tolist()    # -r / sqrt(3): a box corner
+[0.75, -0.144337567297]
 """
 from __future__ import annotations
 
@@ -79,6 +90,7 @@ class TorusFrame:
 
     # -- the surface ---------------------------------------------------------------------
     def u(self, theta):
+        """``cos theta e1 + sin theta e2`` as ``(..., 3)``."""
         return (np.cos(theta)[..., None] * self.e1 + np.sin(theta)[..., None] * self.e2)
 
     def point(self, theta, phi):
@@ -134,36 +146,27 @@ class TorusFrame:
         C = np.einsum("ij,ij->i", y0, y0)
         rho2 = np.einsum("ij,ij->i", perp0, perp0)
         Cp = C + K
-        size = self.R + self.r + np.abs(y0).max(axis=1)
+        size = (self.R + self.r + np.abs(y0).max(axis=1))[:, None]
         best = np.full(len(p), np.inf)
+        A = np.einsum("ij,ij->i", w, w)                 # |d|^2, the same for the 4 lines
+        c4 = A * A
+        yw, aw = y0 * w, w * self.a                     # d = (sx, sy, 1) * w
         for sx in (-1.0, 1.0):
             for sy in (-1.0, 1.0):
-                d = w * np.array([sx, sy, 1.0])
-                A = np.einsum("ij,ij->i", d, d)
-                B = np.einsum("ij,ij->i", y0, d)
-                e = d @ self.a
-                dperp = d - e[:, None] * self.a
-                Ap = np.einsum("ij,ij->i", dperp, dperp)
-                Bp = np.einsum("ij,ij->i", perp0, dperp)
-                c4 = A * A
+                B = sx * yw[:, 0] + sy * yw[:, 1] + yw[:, 2]
+                e = sx * aw[:, 0] + sy * aw[:, 1] + aw[:, 2]
+                Ap = A - e * e                          # |d across the axis|^2
+                Bp = B - g * e
                 t = _quartic_real_roots(4 * A * B / c4,
                                         (4 * B * B + 2 * A * Cp - 4 * R2 * Ap) / c4,
                                         (4 * B * Cp - 8 * R2 * Bp) / c4,
                                         (Cp * Cp - 4 * R2 * rho2) / c4)
-                cols = tuple(v[:, None] for v in (e, g, Ap, Bp, rho2))
-                gap, _ = self._ray_distance(t, *cols)
-                near = np.abs(gap) <= _ON_SURFACE * size[:, None]
+                rho = np.sqrt(np.maximum((Ap[:, None] * t + 2 * Bp[:, None]) * t
+                                         + rho2[:, None], 0.0))
+                gap = np.hypot(rho - self.R, e[:, None] * t + g[:, None]) - self.r
+                near = np.abs(gap) <= _ON_SURFACE * size
                 best = np.fmin(best, np.where(near, np.abs(t), np.inf).min(axis=1))
         return best
-
-    def _ray_distance(self, t, e, g, Ap, Bp, rho2):
-        """Euclidean signed distance to the surface at ``y(t)``, and its ``t``-derivative."""
-        with np.errstate(invalid="ignore", divide="ignore"):
-            rho = np.sqrt(np.maximum((Ap * t + 2 * Bp) * t + rho2, 0.0))
-            z = e * t + g
-            core = np.hypot(rho - self.R, z)
-            slope = ((rho - self.R) * (Ap * t + Bp) / rho + z * e) / core
-        return core - self.r, slope
 
     # edge contacts -------------------------------------------------------------------------
     def _silhouette(self, k) -> dict:
@@ -192,8 +195,15 @@ class TorusFrame:
         arcs, exact = [], []
         for k in range(3):
             if abs(self.a[k]) > _PLANAR:
+                i, j = [m for m in range(3) if m != k]
+                # l . v = v_i / w_i - sigma v_j / w_j: the two planes share the halves
+                inv_i, inv_j = 1.0 / w[:, i], 1.0 / w[:, j]
+                halves = [(inv_i * (self.c[i] - p[:, i]), inv_j * (self.c[j] - p[:, j]))]
+                halves += [(inv_i * v[i], inv_j * v[j]) for v in
+                           (self.e1, self.e2, self._geo[k]["f1"], self._geo[k]["f2"])]
                 for sigma in (-1.0, 1.0):
-                    self._arcs(p, self._edge_normal(w, k, sigma), k, arcs, exact)
+                    dots = [hi_ - sigma * hj for hi_, hj in halves]
+                    self._arcs(dots, k, arcs, exact)
             if abs(self.a[k]) < _NEAR_PLANAR:
                 for sigma in (-1.0, 1.0):
                     self._circle_values(p, w, k, sigma, best)
@@ -213,15 +223,15 @@ class TorusFrame:
                                                         w[owner]))
         return best
 
-    def _arcs(self, p, ell, k, arcs, exact):
-        """The monotone arcs of ``g(theta) = l . (X(theta) - p)`` on both offset curves
-        along ``e_k`` that change sign (appended to ``arcs`` as ``(table, (lo, hi, g_lo,
+    def _arcs(self, dots, k, arcs, exact):
+        """The monotone arcs of ``g(theta) = l . (X(theta) - p)`` (``dots``: ``l`` dotted
+        with ``c - p, e1, e2, f1, f2``) on both offset curves along ``e_k`` that change sign (appended to ``arcs`` as ``(table, (lo, hi, g_lo,
         g_hi))``), and the arc ends within rounding of a root (to ``exact``: a root on the
         wrong side of a rounded critical angle is then not lost)."""
         geo = self._geo[k]
-        L0 = np.einsum("ij,ij->i", ell, self.c - p)
-        L1, L2 = self.R * (ell @ self.e1), self.R * (ell @ self.e2)
-        M1, M2 = self.r * geo["sgn"] * (ell @ geo["f1"]), self.r * geo["sgn"] * (ell @ geo["f2"])
+        l_c, l_e1, l_e2, l_f1, l_f2 = dots          # l.(c - p), l.e1, l.e2, l.f1, l.f2
+        L0, L1, L2 = l_c, self.R * l_e1, self.R * l_e2
+        M1, M2 = self.r * geo["sgn"] * l_f1, self.r * geo["sgn"] * l_f2
         theta0 = np.arctan2(L2, L1)                                 # l . E' = 0 there
         size = np.abs(L0) + np.hypot(L1, L2) + np.hypot(M1, M2)
         # both offsets at once: g = E-part + b * nu-part, on all critical angles
