@@ -109,8 +109,10 @@ def i_mulc(alo, ahi, c: float):
 
 
 def i_divc(alo, ahi, c: float):
-    """``a / c`` for an exact non-zero constant ``c``."""
-    lo, hi = (alo / c, ahi / c) if c > 0.0 else (ahi / c, alo / c)
+    """``a / c`` for an exact non-zero constant ``c`` (overflow gives the infinity
+    the rounded-outward quotient holds)."""
+    with np.errstate(over="ignore"):
+        lo, hi = (alo / c, ahi / c) if c > 0.0 else (ahi / c, alo / c)
     return R.down(lo), R.up(hi)
 
 
@@ -134,7 +136,7 @@ def i_mul(alo, ahi, blo, bhi):
 
 
 def i_div(alo, ahi, blo, bhi):
-    with np.errstate(invalid="ignore", divide="ignore"):
+    with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
         lo, hi = _hull4(alo / blo, alo / bhi, ahi / blo, ahi / bhi)
     holds_zero = (blo <= 0.0) & (bhi >= 0.0)
     lo = np.where(holds_zero, -INF, R.down(lo))
