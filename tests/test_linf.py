@@ -142,6 +142,16 @@ def _brute_classify_sphere(c, r, lo, hi):
     return out, np.minimum(np.abs(near - r), np.abs(far - r))
 
 
+def voxel_boxes(vox):
+    """Every voxel of ``vox``'s grid: integer coordinates ``(n, 3)`` and box corners."""
+    g = vox.grid
+    every = np.stack(np.meshgrid(*[np.arange(k) for k in g.shape], indexing="ij"),
+                     -1).reshape(-1, 3)
+    lo = np.stack([g.edge(a, every[:, a]) for a in range(3)], 1)
+    hi = np.stack([g.edge(a, every[:, a] + 1) for a in range(3)], 1)
+    return every, lo, hi
+
+
 def test_sphere_classification_on_a_million_boxes():
     rng = np.random.default_rng(4)
     s = linf.Sphere((0, 0, 0), 1.0)
@@ -157,10 +167,7 @@ def test_sphere_classification_on_a_million_boxes():
 def test_voxelizing_a_sphere_gives_exactly_the_voxels_it_meets():
     s = linf.Sphere((0.013, -0.021, 0.007), 0.77)
     vox = ivx.voxelize(s, bounds=((-1, -1, -1), (1, 1, 1)), resolution=64)
-    every = np.stack(np.meshgrid(*[np.arange(64)] * 3, indexing="ij"), -1).reshape(-1, 3)
-    g = vox.grid
-    lo = np.stack([g.edge(a, every[:, a]) for a in range(3)], 1)
-    hi = np.stack([g.edge(a, every[:, a] + 1) for a in range(3)], 1)
+    every, lo, hi = voxel_boxes(vox)
     want, margin = _brute_classify_sphere(s.center, s.r, lo, hi)
     got = vox.contains(every)
     assert np.all((got == (want == AMBIGUOUS)) | (margin < 1e-12))
@@ -187,10 +194,7 @@ def test_voxelizing_a_rotated_box_gives_exactly_the_voxels_it_meets():
     from scipy.spatial import ConvexHull
     faces = ConvexHull(corners).simplices
     tris = Triangles(corners[faces])
-    every = np.stack(np.meshgrid(*[np.arange(48)] * 3, indexing="ij"), -1).reshape(-1, 3)
-    g = vox.grid
-    lo = np.stack([g.edge(a, every[:, a]) for a in range(3)], 1)
-    hi = np.stack([g.edge(a, every[:, a] + 1) for a in range(3)], 1)
+    every, lo, hi = voxel_boxes(vox)
     want = np.zeros(len(every), dtype=bool)
     for t in range(len(faces)):
         want |= tris.meet_boxes(np.full(len(every), t), lo, hi)
@@ -251,10 +255,7 @@ def test_voxelizing_a_rotated_ellipsoid_gives_exactly_the_voxels_it_meets():
     rng = np.random.default_rng(7)
     e = linf.Ellipsoid((0.05, -0.03, 0.02), (0.9, 0.5, 0.3), _rotation(rng))
     vox = ivx.voxelize(e, bounds=((-1, -1, -1), (1, 1, 1)), resolution=32)
-    every = np.stack(np.meshgrid(*[np.arange(32)] * 3, indexing="ij"), -1).reshape(-1, 3)
-    g = vox.grid
-    lo = np.stack([g.edge(a, every[:, a]) for a in range(3)], 1)
-    hi = np.stack([g.edge(a, every[:, a] + 1) for a in range(3)], 1)
+    every, lo, hi = voxel_boxes(vox)
     corners = lo[:, None, :] + signs_box()[None] * (hi - lo)[:, None, :]
     y = corners - e.center
     qmax = np.einsum("nci,ij,ncj->nc", y, e.Q, y).max(axis=1)
@@ -337,10 +338,7 @@ def test_voxelizing_a_rotated_cylinder_gives_exactly_the_voxels_it_meets():
     assert isinstance(cyl, linf.Frustum) and cyl.r1 == cyl.r2 == 0.35
     vox = ivx.voxelize(cyl, bounds=((-1, -1, -1), (1, 1, 1)), resolution=32)
     g = _cylinder_constraints(cyl)
-    every = np.stack(np.meshgrid(*[np.arange(32)] * 3, indexing="ij"), -1).reshape(-1, 3)
-    grid = vox.grid
-    lo = np.stack([grid.edge(a, every[:, a]) for a in range(3)], 1)
-    hi = np.stack([grid.edge(a, every[:, a] + 1) for a in range(3)], 1)
+    every, lo, hi = voxel_boxes(vox)
     got = vox.contains(every)
     corners = lo[:, None, :] + signs_box()[None] * (hi - lo)[:, None, :]
     all_in = np.array([all(g(c).min() >= 0 for c in cs) for cs in corners])
@@ -532,11 +530,7 @@ def test_voxelizing_a_torus_gives_exactly_the_voxels_it_meets():
     import csg
     solid = csg.Torus(0.8, 0.25).rotate((1, 0, 0), 90).translate((0.013, -0.021, 0.017))
     vox = solid.voxelize(48)
-    g = vox.grid
-    every = np.stack(np.meshgrid(*[np.arange(k) for k in g.shape], indexing="ij"),
-                     -1).reshape(-1, 3)
-    lo = np.stack([g.edge(a, every[:, a]) for a in range(3)], 1)
-    hi = np.stack([g.edge(a, every[:, a] + 1) for a in range(3)], 1)
+    every, lo, hi = voxel_boxes(vox)
     c = np.array([0.013, -0.021, 0.017])
     perm = [0, 2, 1]                       # the torus axis (y) last: local (x, z, y)
     llo, lhi = (lo - c)[:, perm], (hi - c)[:, perm]
@@ -626,11 +620,7 @@ def test_voxelizing_a_tilted_torus_gives_exactly_the_voxels_it_meets():
     R, r = 0.8, 0.25
     solid = csg.Torus(R, r).rotate((1.0, 2.0, 0.5), 37).translate((0.013, -0.021, 0.017))
     vox = solid.voxelize(40)
-    g = vox.grid
-    every = np.stack(np.meshgrid(*[np.arange(k) for k in g.shape], indexing="ij"),
-                     -1).reshape(-1, 3)
-    lo = np.stack([g.edge(a, every[:, a]) for a in range(3)], 1)
-    hi = np.stack([g.edge(a, every[:, a] + 1) for a in range(3)], 1)
+    every, lo, hi = voxel_boxes(vox)
     m = csg.rotation_matrix((1.0, 2.0, 0.5), 37)
     e1, e2, a = m[:, 0], m[:, 1], m[:, 2]
     c = np.array([0.013, -0.021, 0.017])
@@ -735,11 +725,7 @@ def test_voxelizing_a_turned_hyperboloid_gives_exactly_the_voxels_it_meets():
     Q = linf.Quadric.from_local(np.diag([1.0, 2.0, -0.5]), np.zeros(3), -0.3, _rotation(rng),
                                 (0.03, -0.02, 0.01))
     vox = ivx.voxelize(Q, bounds=((-1, -1, -1), (1, 1, 1)), resolution=40)
-    g = vox.grid
-    every = np.stack(np.meshgrid(*[np.arange(k) for k in g.shape], indexing="ij"),
-                     -1).reshape(-1, 3)
-    lo = np.stack([g.edge(a, every[:, a]) for a in range(3)], 1)
-    hi = np.stack([g.edge(a, every[:, a] + 1) for a in range(3)], 1)
+    every, lo, hi = voxel_boxes(vox)
     vmin, vmax = quadric_box_range(Q.A, Q.b, Q.c, lo, hi)
     truth = (vmin <= 0) & (vmax >= 0)
     sure = (np.abs(vmin) > 1e-12) & (np.abs(vmax) > 1e-12)
