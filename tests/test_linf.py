@@ -421,7 +421,8 @@ def _torus_frame(tor):
 
 @pytest.mark.parametrize("axis, n", [("y", 10_000), ("x", 2000), ("z", 2000), ("random", 10_000),
                                      ("in the xy plane (a_z = 0)", 2000),
-                                     ("1e-9 off the xy plane", 2000), ("3e-8 off the xy plane", 2000),
+                                     ("1e-9 off the xy plane", 2000),
+                                     ("3e-8 off the xy plane", 2000),
                                      ("1e-7 off the z axis", 2000),
                                      ("rotation round-off (a_z = 1e-17)", 2000)])
 def test_torus_matches_brute_force(axis, n):

@@ -40,7 +40,6 @@ _LINE_SIGNS = [(sx, sy) for sx in (-1.0, 1.0) for sy in (-1.0, 1.0)]
 _EDGES = [(i, j, k) for k, (i, j) in enumerate([(1, 2), (2, 0), (0, 1)])]
 
 
-
 def _roots(A, B, C):
     """Roots ``t1 <= t2`` of ``A t^2 + 2 B t + C = 0`` (A > 0), stable; NaN if none."""
     disc = B * B - A * C

@@ -86,6 +86,9 @@ class TorusFrame:
         self.R, self.r = float(R), float(r)
         self.faces = self._face_points()
         self._geo = [self._silhouette(k) for k in range(3)]
+        #: the silhouette constants stacked by axis, for per-lane lookup
+        self._f1, self._f2, self._sgn = (np.array([g[c] for g in self._geo])
+                                         for c in ("f1", "f2", "sgn"))
         self._cusps = [self._cusp_angles(k) for k in range(3)]
 
     # -- the surface ---------------------------------------------------------------------
@@ -209,7 +212,7 @@ class TorusFrame:
                     self._circle_values(p, w, k, sigma, best)
         if not arcs:
             return best
-        table = np.concatenate([a[0] for a in arcs], axis=1)   # rows: see _ARC_ROWS
+        table = np.concatenate([a[0] for a in arcs], axis=1)   # rows: see _G_ROWS
         lo, hi, glo, ghi = (np.concatenate([a[1][i] for a in arcs]) for i in range(4))
         theta = _monotone_root(
             lambda x, idx: self._offset_g(x, *(table if len(idx) == table.shape[1]
@@ -225,9 +228,10 @@ class TorusFrame:
 
     def _arcs(self, dots, k, arcs, exact):
         """The monotone arcs of ``g(theta) = l . (X(theta) - p)`` (``dots``: ``l`` dotted
-        with ``c - p, e1, e2, f1, f2``) on both offset curves along ``e_k`` that change sign (appended to ``arcs`` as ``(table, (lo, hi, g_lo,
-        g_hi))``), and the arc ends within rounding of a root (to ``exact``: a root on the
-        wrong side of a rounded critical angle is then not lost)."""
+        with ``c - p, e1, e2, f1, f2``) on both offset curves along ``e_k`` that change
+        sign (appended to ``arcs`` as ``(table, (lo, hi, g_lo, g_hi))``), and the arc ends
+        within rounding of a root (to ``exact``: a root on the wrong side of a rounded
+        critical angle is then not lost)."""
         geo = self._geo[k]
         l_c, l_e1, l_e2, l_f1, l_f2 = dots          # l.(c - p), l.e1, l.e2, l.f1, l.f2
         L0, L1, L2 = l_c, self.R * l_e1, self.R * l_e2
@@ -273,11 +277,8 @@ class TorusFrame:
         """``||p - s||_w`` for ``s = c + R u(theta) + b r nu(theta)`` on the silhouette
         along ``e_K`` (per lane; ``b = 1`` outer, ``-1`` inner offset), ``p, w`` per lane."""
         s, co = np.sin(theta), np.cos(theta)
-        f1 = np.array([g["f1"] for g in self._geo])
-        f2 = np.array([g["f2"] for g in self._geo])
-        sgn = np.array([g["sgn"] for g in self._geo])
-        comps = [-s * f1[K, i] + co * f2[K, i] for i in range(3)]
-        scale = b * sgn[K] * self.r / np.sqrt(comps[0] ** 2 + comps[1] ** 2 + comps[2] ** 2)
+        comps = [-s * self._f1[K, i] + co * self._f2[K, i] for i in range(3)]
+        scale = b * self._sgn[K] * self.r / np.sqrt(comps[0] ** 2 + comps[1] ** 2 + comps[2] ** 2)
         out = None
         for i in range(3):
             point = self.c[i] + self.R * (co * self.e1[i] + s * self.e2[i]) + scale * comps[i]
