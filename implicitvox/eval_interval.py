@@ -13,7 +13,7 @@ from .tape import Tape
 __all__ = ["evaluate_intervals", "CHUNK"]
 
 #: boxes per pass: the working set of a tape (a few dozen arrays) stays in cache
-CHUNK = 1 << 14
+CHUNK = 1 << 16
 
 
 def evaluate_intervals(tape: Tape, lo: tuple[np.ndarray, np.ndarray, np.ndarray],

@@ -50,9 +50,10 @@ class Subdivision:
 
 
 def _states(flo: np.ndarray, fhi: np.ndarray) -> np.ndarray:
-    state = np.full(flo.shape[0], AMBIGUOUS, dtype=np.int8)
-    state[fhi < 0.0] = FULL
-    state[flo > 0.0] = EMPTY  # also the empty interval (inf, -inf): undefined
+    """EMPTY where ``flo > 0`` (also the empty interval ``(inf, -inf)``: undefined),
+    else FULL where ``fhi < 0``, else AMBIGUOUS; branch-free (the masks are random)."""
+    state = np.subtract(AMBIGUOUS, fhi < 0.0, dtype=np.int8)   # FULL = AMBIGUOUS - 1
+    state *= flo <= 0.0                                         # EMPTY = 0
     return state
 
 
@@ -92,33 +93,39 @@ def _tighten(func: Function, lo, hi, flo: np.ndarray, fhi: np.ndarray, state: np
     return state
 
 
-def _children(grid: Grid, level: int, parents: np.ndarray) -> np.ndarray:
-    """The 8 children of each parent at ``level + 1``, cropped to the grid."""
-    kids = (parents[:, None, :] * 2 + _CHILD_OFFSETS[None, :, :]).reshape(-1, 3)
-    inside = _inside(grid, level + 1, kids)
-    return kids if inside is None else kids[inside]
-
-
-def _inside(grid: Grid, level: int, octants: np.ndarray) -> Optional[np.ndarray]:
-    """Which octants at ``level`` meet the grid (None: all, the grid fills the octree)."""
-    if all(n == 1 << grid.depth for n in grid.shape):
-        return None
-    limits = [-(-n // (1 << (grid.depth - level))) for n in grid.shape]  # octants per axis
-    return (octants[:, 0] < limits[0]) & (octants[:, 1] < limits[1]) & (octants[:, 2] < limits[2])
-
-
 _BROADCAST = [(1, 1, 2, -1), (1, 2, 1, -1), (2, 1, 1, -1)]
 
+# Octants on the stack are int64 keys ``i | j << 21 | k << 42`` (coordinates
+# have at most 21 bits, morton.MAX_BITS): a child is ``2 * parent + offset``,
+# and selecting kept children gathers one integer per octant, not three.
+_FIELD = 21
+_MASK = (1 << _FIELD) - 1
+_CHILD_KEYS = (_CHILD_OFFSETS.astype(np.int64) << (_FIELD * np.arange(3))).sum(axis=1)
 
-def _child_boxes(grid: Grid, level: int, parents: np.ndarray):
-    """Per-axis bounds of the children, shaped to broadcast: ``x (1, 1, 2, m)``,
-    ``y (1, 2, 1, m)``, ``z (2, 1, 1, m)``; the (2, 2, 2, m) result reshapes to
-    ``(8, m)`` in child order ``x + 2y + 4z``. Children past the grid get
-    degenerate boxes on its edge (they are dropped after)."""
+
+def _pack(coords: np.ndarray) -> np.ndarray:
+    c = np.asarray(coords, dtype=np.int64).reshape(-1, 3)
+    return c[:, 0] | (c[:, 1] << _FIELD) | (c[:, 2] << (2 * _FIELD))
+
+
+def _axes(keys: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    return keys & _MASK, (keys >> _FIELD) & _MASK, keys >> (2 * _FIELD)
+
+
+def _unpack(keys: np.ndarray) -> np.ndarray:
+    return np.stack(_axes(keys), axis=1).astype(np.int32)
+
+
+def _child_boxes(grid: Grid, level: int, parents: tuple[np.ndarray, ...]):
+    """Per-axis bounds of the children of octants ``parents`` (per-axis
+    coordinates), shaped to broadcast: ``x (1, 1, 2, m)``, ``y (1, 2, 1, m)``,
+    ``z (2, 1, 1, m)``; the (2, 2, 2, m) result reshapes to ``(8, m)`` in
+    child order ``x + 2y + 4z``. Children past the grid get degenerate boxes
+    on its edge (they are dropped after)."""
     scale = float(1 << (grid.depth - level - 1))
     lo, hi = [], []
     for a in range(3):
-        first = (parents[None, :, a].astype(np.float64) * 2.0 + _HALVES) * scale
+        first = (parents[a][None, :].astype(np.float64) * 2.0 + _HALVES) * scale
         last = np.minimum(first + scale, grid.shape[a])
         first = np.minimum(first, grid.shape[a])
         lo.append(grid.edge(a, first).reshape(_BROADCAST[a]))
@@ -130,29 +137,49 @@ _HALVES = np.array([[0.0], [1.0]])
 
 
 def classify_children(func: Function, grid: Grid, level: int, parents: np.ndarray,
-                      exact=None, mean_value: bool = False) -> tuple[np.ndarray, np.ndarray]:
-    """Children (8m - cropped, 3) of octants at ``level`` and their states.
+                      exact=None, mean_value: bool = False
+                      ) -> tuple[np.ndarray, np.ndarray, int]:
+    """The children of octants at ``level`` that are not EMPTY, and their states.
 
-    One broadcast interval evaluation for all children (see
+    ``parents`` and the children returned are packed keys (see
+    :func:`_pack`). One broadcast interval evaluation for all children (see
     :func:`_child_boxes`); the mean value form and the exact test then run on
-    the AMBIGUOUS ones, as in :func:`classify`.
+    the AMBIGUOUS ones, as in :func:`classify`. Returns ``(kids, states,
+    classified)``, the last the number of children inside the grid.
     """
-    lo, hi = _child_boxes(grid, level, parents)
+    axes = _axes(parents)
+    lo, hi = _child_boxes(grid, level, axes)
     flo, fhi = func.interval_columns(lo, hi)
-    kids = (parents[None, :, :] * 2 + _CHILD_OFFSETS[:, None, :]).reshape(-1, 3)
-    flo, fhi = flo.reshape(-1), fhi.reshape(-1)
+    flo, fhi = flo.reshape(-1), fhi.reshape(-1)     # child-major: index = child * m + parent
     state = _states(flo, fhi)
-    inside = _inside(grid, level + 1, kids)
+    classified = state.size
+    inside = _inside_children(grid, level + 1, axes)
     if inside is not None:
-        kids, state, flo, fhi = kids[inside], state[inside], flo[inside], fhi[inside]
+        state *= inside
+        classified = int(np.count_nonzero(inside))
+    keep = np.flatnonzero(state)                    # EMPTY is 0
+    kids = ((parents << 1)[None, :] + _CHILD_KEYS[:, None]).reshape(-1)[keep]
+    state, flo, fhi = state[keep], flo[keep], fhi[keep]
     if mean_value or exact is not None:
         amb = np.flatnonzero(state == AMBIGUOUS)
         if amb.size:
             # the natural bounds are known: only the boxes are rebuilt, as columns
-            box_lo, box_hi = grid.octant_boxes(level + 1, kids[amb])
+            box_lo, box_hi = grid.octant_boxes(level + 1, _unpack(kids[amb]))
             state[amb] = _tighten(func, box_lo, box_hi, flo[amb], fhi[amb], state[amb],
                                   exact, mean_value)
-    return kids, state
+    return kids, state, classified
+
+
+def _inside_children(grid: Grid, level: int, axes) -> Optional[np.ndarray]:
+    """Which children (child-major, ``8 m``) at ``level`` of the parents with
+    coordinates ``axes`` meet the grid (None: all)."""
+    if all(n == 1 << grid.depth for n in grid.shape):
+        return None
+    limits = [-(-n // (1 << (grid.depth - level))) for n in grid.shape]  # octants per axis
+    inside = np.ones((8, len(axes[0])), dtype=bool)
+    for a in range(3):
+        inside &= (axes[a][None, :] * 2 + _CHILD_OFFSETS[:, a, None]) < limits[a]
+    return inside.reshape(-1)
 
 
 class _Progress:
@@ -219,23 +246,23 @@ def subdivide(func: Function, grid: Grid, *, start: Optional[tuple[int, np.ndarr
         state = classify(func, grid, 0, root, exact_voxels if depth == 0 else exact, mean_value)
         evaluated = 1
         if state[0] == FULL and interior:
-            interior_parts[0] = [root]
+            interior_parts[0] = [_pack(root)]
         elif state[0] == AMBIGUOUS:
             if depth == 0:
-                surface.append(root)
+                surface.append(_pack(root))
             else:
-                stack.append((0, root))
+                stack.append((0, _pack(root)))
     else:
         level0, coords0 = start
-        coords0 = np.asarray(coords0, dtype=np.int32).reshape(-1, 3)
-        stack.extend((level0, coords0[s:s + per_step]) for s in range(0, len(coords0), per_step))
+        keys0 = _pack(coords0)
+        stack.extend((level0, keys0[s:s + per_step]) for s in range(0, len(keys0), per_step))
     meter = _Progress(progress, depth)
     while stack:
         level, parents = stack.pop()
-        kids, state = classify_children(func, grid, level, parents,
-                                        exact_voxels if level + 1 == depth else exact, mean_value)
-        evaluated += len(kids)
-        meter.done += len(kids)
+        kids, state, classified = classify_children(
+            func, grid, level, parents, exact_voxels if level + 1 == depth else exact, mean_value)
+        evaluated += classified
+        meter.done += classified
         if interior:
             full = kids[state == FULL]
             if len(full):
@@ -251,7 +278,7 @@ def subdivide(func: Function, grid: Grid, *, start: Optional[tuple[int, np.ndarr
         progress(1.0)
     empty = np.zeros((0, 3), dtype=np.int32)
     return Subdivision(
-        surface=np.concatenate(surface).astype(np.int32, copy=False) if surface else empty,
-        interior={lvl: np.concatenate(parts).astype(np.int32, copy=False)
+        surface=_unpack(np.concatenate(surface)) if surface else empty,
+        interior={lvl: _unpack(np.concatenate(parts))
                   for lvl, parts in sorted(interior_parts.items())},
         evaluated=evaluated)

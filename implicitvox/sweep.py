@@ -293,8 +293,7 @@ class PolarSweep(_Compiled):
 
     def _sector_box(self, ulo, uhi, vlo, vhi):
         """Bounding box of the fundamental sector between the box's radii."""
-        rlo = R.down_nonneg(np.hypot(I.mignitude(ulo, uhi), I.mignitude(vlo, vhi)), 2)
-        rhi = R.up_nonneg(np.hypot(I.magnitude(ulo, uhi), I.magnitude(vlo, vhi)), 2)
+        rlo, rhi = I.i_hypot(ulo, uhi, vlo, vhi)
         half = self.step / 2
         if half >= np.pi / 2:  # n <= 2: a half plane or the whole plane
             ulo_s = -rhi if half > np.pi / 2 else np.zeros_like(rhi)
