@@ -24,6 +24,8 @@ import time
 import traceback
 from typing import Any, Optional, Sequence
 
+from .subdivide import RECHECK
+
 __all__ = ["main", "ProgressBar", "load_model"]
 
 
@@ -125,6 +127,9 @@ def _parser() -> argparse.ArgumentParser:
                      help="tighter: mean value form on ambiguous octants (about 3x the time)")
     vox.add_argument("--subvoxel", type=int, default=0, metavar="K",
                      help="tighter: keep a voxel only if a sub-voxel K levels down is ambiguous")
+    vox.add_argument("--recheck", type=float, default=RECHECK, metavar="SHARE",
+                     help="recheck on sub-voxels the voxels whose interval holds 0 within this "
+                          f"share of an end (default {RECHECK}; 0 = off)")
     vox.add_argument("--out", help="write .npz, .vti or .binvox")
     vox.add_argument("--render", metavar="PNG", help="render a picture")
     vox.add_argument("--max-memory", type=float, metavar="GIB", help="refuse runs estimated above")
@@ -175,7 +180,7 @@ def _voxelize(args: argparse.Namespace) -> int:
         vox = voxelize(shape, bounds, args.resolution, interior=args.interior,
                        normals=args.normals or bool(args.render), progress=bar,
                        max_memory=max_memory, mean_value=args.mean_value,
-                       subvoxel=args.subvoxel)
+                       subvoxel=args.subvoxel, recheck=args.recheck)
     if bar:
         bar.close()
     meta = vox.metadata

@@ -8,16 +8,18 @@ from __future__ import annotations
 
 import numpy as np
 
+from . import interval as I
+from .precision import CONSTANT_OPERAND, exact_in_float32, float32_bounds, outward_float32
 from .tape import Tape
 
-__all__ = ["evaluate_intervals", "CHUNK"]
+__all__ = ["evaluate_intervals", "apply_op", "CHUNK"]
 
 #: boxes per pass: the working set of a tape (a few dozen arrays) stays in cache
 CHUNK = 1 << 16
 
 
 def evaluate_intervals(tape: Tape, lo: tuple[np.ndarray, np.ndarray, np.ndarray],
-                       hi: tuple[np.ndarray, np.ndarray, np.ndarray]
+                       hi: tuple[np.ndarray, np.ndarray, np.ndarray], dtype=np.float64
                        ) -> tuple[np.ndarray, np.ndarray]:
     """Enclosures ``(flo, fhi)`` of the taped function over boxes.
 
@@ -33,6 +35,10 @@ def evaluate_intervals(tape: Tape, lo: tuple[np.ndarray, np.ndarray, np.ndarray]
         ``(2, 1, 1, m)``, so a subexpression of ``x`` alone is computed on 2
         boxes per octant instead of 8 (broadcasting does the rest; the long
         axis is innermost, where numpy's loops are fast).
+    dtype : float64 or float32
+        What the kernels compute in. float32 (only for tapes that
+        :func:`implicitvox.precision.interval_dtype` allows) rounds the boxes
+        outward to float32 first; the enclosures are returned as float64.
 
     Returns
     -------
@@ -43,15 +49,33 @@ def evaluate_intervals(tape: Tape, lo: tuple[np.ndarray, np.ndarray, np.ndarray]
     columns = shape[-1] if shape else 1
     per_column = max(1, int(np.prod(shape[:-1], dtype=np.int64))) if shape else 1
     step = max(1, CHUNK // per_column)
+    single = np.dtype(dtype) == np.float32
+    if single:
+        lo, hi = zip(*(outward_float32(a, b) for a, b in zip(lo, hi)))
     if columns > step:
         parts = [_evaluate(tape, tuple(c[..., s:s + step] for c in lo),
-                           tuple(c[..., s:s + step] for c in hi)) for s in range(0, columns, step)]
+                           tuple(c[..., s:s + step] for c in hi), single)
+                 for s in range(0, columns, step)]
         return (np.concatenate([p[0] for p in parts], axis=-1),
                 np.concatenate([p[1] for p in parts], axis=-1))
-    return _evaluate(tape, lo, hi)
+    return _evaluate(tape, lo, hi, single)
 
 
-def _evaluate(tape, lo, hi):
+def apply_op(op, param, lo: tuple, hi: tuple, single: bool = False):
+    """One instruction's kernel on argument bounds ``lo, hi`` (float32 arrays
+    when ``single``). In float32, ``addc, rsubc, mulc`` whose constant float32
+    cannot hold run as the operation on the constant's two-float32 interval."""
+    if single and op.name in CONSTANT_OPERAND and not exact_in_float32(param):
+        clo, chi = float32_bounds(param)
+        if op.name == "addc":
+            return I.i_add(lo[0], hi[0], clo, chi)
+        if op.name == "rsubc":
+            return I.i_sub(clo, chi, lo[0], hi[0])
+        return I.i_mul(lo[0], hi[0], clo, chi)
+    return op.interval(lo, hi, param)
+
+
+def _evaluate(tape, lo, hi, single=False):
     shape = np.broadcast_shapes(*(a.shape for a in lo), *(a.shape for a in hi))
     if tape.undefined:
         return np.full(shape, np.inf), np.full(shape, -np.inf)
@@ -62,12 +86,15 @@ def _evaluate(tape, lo, hi):
         if r >= 0:
             rlo[r], rhi[r] = lo[axis], hi[axis]
     for c in tape.constants:
-        rlo[c.register], rhi[c.register] = np.float64(c.lo), np.float64(c.hi)
+        if single:
+            rlo[c.register], rhi[c.register] = float32_bounds(c.lo)[0], float32_bounds(c.hi)[1]
+        else:
+            rlo[c.register], rhi[c.register] = np.float64(c.lo), np.float64(c.hi)
     empty = None
     with np.errstate(all="ignore"):
         for ins in tape.instructions:
-            result = ins.op.interval(tuple(rlo[a] for a in ins.args),
-                                     tuple(rhi[a] for a in ins.args), ins.param)
+            result = apply_op(ins.op, ins.param, tuple(rlo[a] for a in ins.args),
+                              tuple(rhi[a] for a in ins.args), single)
             if ins.op.domain:
                 result, lane_empty = result[:2], result[2]
                 empty = lane_empty if empty is None else (empty | lane_empty)

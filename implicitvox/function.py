@@ -140,10 +140,11 @@ class Function:
                              f"{lo_arr[i, k]!r} > {hi_arr[i, k]!r}")
         return self.interval_columns(tuple(lo_arr.T), tuple(hi_arr.T))
 
-    def interval_columns(self, lo: tuple[np.ndarray, ...], hi: tuple[np.ndarray, ...]
-                         ) -> tuple[np.ndarray, np.ndarray]:
-        """:meth:`interval` on per-axis columns, unchecked (the subdivision's fast path)."""
-        return evaluate_intervals(self.tape, lo, hi)
+    def interval_columns(self, lo: tuple[np.ndarray, ...], hi: tuple[np.ndarray, ...],
+                         dtype=np.float64) -> tuple[np.ndarray, np.ndarray]:
+        """:meth:`interval` on per-axis columns, unchecked (the subdivision's fast path);
+        ``dtype`` float32 only where :func:`implicitvox.precision.interval_dtype` allows."""
+        return evaluate_intervals(self.tape, lo, hi, dtype)
 
 
 def _box_array(a: Any, name: str) -> np.ndarray:

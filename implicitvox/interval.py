@@ -234,13 +234,16 @@ def _holds_phase(q_lo, q_hi, phase: float):
 
 
 def _in_periods(alo, ahi, period: float):
-    """``[alo, ahi]`` in periods, widened by a slack of ``1e-12 (1 + |u|)`` periods
-    (an infinite end gives an infinite slack: every phase is held)."""
+    """``[alo, ahi]`` in periods, widened by a slack of ``s (1 + |u|)`` periods,
+    ``s`` = 1e-12 in float64 and 2**-20 in float32, far above the few roundings
+    of the conversion and of :func:`_holds_phase` (an infinite end gives an
+    infinite slack: every phase is held)."""
     u_lo = alo * (1.0 / period)
     u_hi = ahi * (1.0 / period)
+    rel = 2.0 ** -20 if u_lo.dtype == np.float32 else 1e-12
     slack = np.maximum(-u_lo, u_hi)        # the larger |u| (u_lo <= u_hi)
-    slack *= 1e-12
-    slack += 1e-12
+    slack *= rel
+    slack += rel
     return u_lo - slack, u_hi + slack
 
 
@@ -293,15 +296,23 @@ def cos_values(a):
     return np.where(np.abs(t) > 1.0, near_zero, near_one)
 
 
-def _periodic(alo, ahi, values, ulps: int, max_phase: float, min_phase: float):
+def _periodic(alo, ahi, fast, numpy_values, ulps: int, max_phase: float, min_phase: float):
+    """``sin`` or ``cos`` over intervals: the end values, and 1 or -1 where an
+    extremum lies inside. float64 ends come from ``fast`` (tangents, widened by
+    ``ulps``); float32 ones from numpy's own float32 function, which is
+    vectorized (widened by ``TRANSCENDENTAL_ULPS``)."""
+    single = alo.dtype == np.float32
     with np.errstate(invalid="ignore", divide="ignore"):
-        fa, fb = values(alo), values(ahi)
+        fa, fb = (numpy_values(alo), numpy_values(ahi)) if single else (fast(alo), fast(ahi))
         q_lo, q_hi = _in_periods(alo, ahi, _TWO_PI)
         has_max = _holds_phase(q_lo, q_hi, max_phase)
         has_min = _holds_phase(q_lo, q_hi, min_phase)
-    # one subnormal float more than R.down/up give: a halving below 2**-1021 rounds
-    lo = R.down(np.fmin(fa, fb), ulps) - _TINY
-    hi = R.up(np.fmax(fa, fb), ulps) + _TINY
+    if single:
+        lo, hi = R.down(np.fmin(fa, fb), T), R.up(np.fmax(fa, fb), T)
+    else:
+        # one subnormal float more than R.down/up give: a halving below 2**-1021 rounds
+        lo = R.down(np.fmin(fa, fb), ulps) - _TINY
+        hi = R.up(np.fmax(fa, fb), ulps) + _TINY
     hi = np.where(has_max, 1.0, np.minimum(hi, 1.0))
     lo = np.where(has_min, -1.0, np.maximum(lo, -1.0))
     # sin(inf) is NaN: an infinite endpoint made the slack infinite, so both are held.
@@ -309,11 +320,11 @@ def _periodic(alo, ahi, values, ulps: int, max_phase: float, min_phase: float):
 
 
 def i_sin(alo, ahi):
-    return _periodic(alo, ahi, sin_values, R.SIN_ULPS, 0.25, 0.75)
+    return _periodic(alo, ahi, sin_values, np.sin, R.SIN_ULPS, 0.25, 0.75)
 
 
 def i_cos(alo, ahi):
-    return _periodic(alo, ahi, cos_values, R.COS_ULPS, 0.0, 0.5)
+    return _periodic(alo, ahi, cos_values, np.cos, R.COS_ULPS, 0.0, 0.5)
 
 
 def i_tan(alo, ahi):
@@ -383,7 +394,8 @@ def _norm(a, b, c=None):
     The squares, the sums and the root, each rounded to nearest, leave a
     relative error below ``2**-52`` for two terms and ``2 * 2**-52`` for
     three; the callers widen by 2 and 3 floats. Where a square could
-    overflow or underflow (outside ``1e-150 .. 1e150``) the slower ``hypot``
+    overflow or underflow (outside ``1e-150 .. 1e150``; in float32 ``1e-18 ..
+    1e18``) the slower ``hypot``
     (libm, below 1 ulp) is used instead.
     """
     total = a * a + b * b
@@ -392,7 +404,8 @@ def _norm(a, b, c=None):
         total = total + c * c
         top = np.maximum(top, c)
     out = np.sqrt(total)
-    risky = (top > 1e150) | ((top < 1e-150) & (top > 0.0))
+    big = 1e18 if out.dtype == np.float32 else 1e150   # squares stay normal and finite
+    risky = (top > big) | ((top < 1.0 / big) & (top > 0.0))
     if np.any(risky):
         safe = np.hypot(a, b) if c is None else np.hypot(np.hypot(a, b), c)
         out = np.where(risky, safe, out)
@@ -410,6 +423,10 @@ def i_radius(ulo, uhi, vlo, vhi, wlo, whi):
 _SQRT_MAX_DOWN = float(np.sqrt(np.finfo(np.float64).max)) * (1.0 - 2.0 ** -48)
 #: above every rounding error that underflowing squares leave after the root
 _UNDERFLOW_ROOT = 2.0 ** -536
+#: (eps, underflow root, sqrt max down) by float type (float32: squares lose 2**-150)
+_DISTANCE_LIMITS = {False: (R.EPS, _UNDERFLOW_ROOT, _SQRT_MAX_DOWN),
+                    True: (2.0 ** -23, 2.0 ** -74,
+                           float(np.sqrt(np.float64(np.finfo(np.float32).max))) * (1.0 - 2.0 ** -20))}
 
 
 def _offset_square_extents(alo, ahi, c: float):
@@ -445,9 +462,11 @@ def i_distance(alo, ahi, blo, bhi, wlo, whi, centre):
     n0, f0 = _offset_square_extents(alo, ahi, c0)
     n1, f1 = _offset_square_extents(blo, bhi, c1)
     n2, f2 = _offset_square_extents(wlo, whi, c2)
-    lo = np.sqrt((n0 + n1) + n2) * (1.0 - 3.0 * R.EPS) - _UNDERFLOW_ROOT
-    hi = np.sqrt((f0 + f1) + f2) * (1.0 + 3.0 * R.EPS) + _UNDERFLOW_ROOT
-    return np.clip(lo, 0.0, _SQRT_MAX_DOWN), hi
+    near, far = np.sqrt((n0 + n1) + n2), np.sqrt((f0 + f1) + f2)
+    eps, underflow_root, sqrt_max_down = _DISTANCE_LIMITS[near.dtype == np.float32]
+    lo = near * (1.0 - 3.0 * eps) - underflow_root
+    hi = far * (1.0 + 3.0 * eps) + underflow_root
+    return np.clip(lo, 0.0, sqrt_max_down), hi
 
 
 def i_elevation(ulo, uhi, vlo, vhi, wlo, whi):
@@ -478,25 +497,36 @@ def angle_interval(vlo, vhi, ulo, uhi):
     (the cut) gets ``[atan2(v_hi, u_hi), atan2(v_lo, u_hi) + 2 pi]``: an
     interval that holds every angle of the box *modulo 2 pi*, so it is valid
     only inside functions of period ``2 pi`` (``sin(k theta + c)`` with
-    integer ``k``). ``whole`` marks boxes that hold the origin (every angle).
+    integer ``k``). ``whole`` marks boxes that hold the origin (every angle;
+    their interval is ``[-pi, pi]``).
     """
-    lo, hi = i_atan2(vlo, vhi, ulo, uhi)
+    lo, hi = _unwrapped_angle(vlo, vhi, ulo, uhi)
     whole = (ulo <= 0.0) & (uhi >= 0.0) & (vlo <= 0.0) & (vhi >= 0.0)
-    cut = (uhi < 0.0) & (vlo <= 0.0) & (vhi >= 0.0)
-    if np.any(cut):
-        a = R.down(np.arctan2(vhi, uhi), T)
-        b = R.up(R.up(np.arctan2(vlo, uhi), T) + TWO_PI_UP)
-        lo = np.where(cut, a, lo)
-        hi = np.where(cut, b, hi)
     return lo, hi, whole
+
+
+def _unwrapped_angle(vlo, vhi, ulo, uhi):
+    lo, hi = i_atan2(vlo, vhi, ulo, uhi)
+    cut = (uhi < 0.0) & (vlo <= 0.0) & (vhi >= 0.0)
+    if np.any(cut):   # few boxes: computed on those alone
+        where = np.nonzero(cut)
+        v_lo, v_hi, u_hi = (np.broadcast_to(a, cut.shape)[where] for a in (vlo, vhi, uhi))
+        lo, hi = np.array(lo), np.array(hi)
+        lo[where] = R.down(np.arctan2(v_hi, u_hi), T)
+        # v = +0 is on the upper side (atan2 gives +pi there): as -0 it gives -pi,
+        # and the unwrapped end pi, not 3 pi
+        hi[where] = R.up(R.up(np.arctan2(np.copysign(v_lo, -1.0), u_hi), T) + TWO_PI_UP)
+    return lo, hi
 
 
 def i_periodic_angle(vlo, vhi, ulo, uhi, fn: str, k: float, c: float):
     """``sin`` or ``cos`` of ``k * atan2(v, u) + c`` for an integer ``k``, tight
-    across the branch cut (see :func:`angle_interval`)."""
-    alo, ahi, whole = angle_interval(vlo, vhi, ulo, uhi)
+    across the branch cut (see :func:`angle_interval`). A box holding the
+    origin has the angle interval ``[-pi, pi]``, ``k`` times which holds a
+    whole period for ``k != 0``: its enclosure is ``[-1, 1]`` without a test
+    (and for ``k = 0`` the function is the constant it gives)."""
+    alo, ahi = _unwrapped_angle(vlo, vhi, ulo, uhi)
     alo, ahi = i_mulc(alo, ahi, k)
     if c != 0.0:
         alo, ahi = i_addc(alo, ahi, c)
-    lo, hi = (i_sin if fn == "sin" else i_cos)(alo, ahi)
-    return np.where(whole, -1.0, lo), np.where(whole, 1.0, hi)
+    return (i_sin if fn == "sin" else i_cos)(alo, ahi)

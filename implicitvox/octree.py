@@ -91,7 +91,16 @@ class Octree:
             raise ValueError(f"coords must have shape (n, 3), got {coords.shape}")
         if len(coords) and (coords.min() < 0 or coords.max() >= (1 << depth)):
             raise ValueError(f"coords must lie in [0, {1 << depth}) for depth {depth}")
-        codes = morton.encode(coords)
+        return cls.from_codes(morton.encode(coords), depth, payload)
+
+    @classmethod
+    def from_codes(cls, codes: np.ndarray, depth: int,
+                   payload: Optional[dict[str, np.ndarray]] = None) -> "Octree":
+        """Bulk insert of voxels given by Morton codes (uint64; sorted here, in
+        place, duplicates merged), as :meth:`from_coords`."""
+        codes = np.asarray(codes, dtype=np.uint64)
+        if len(codes) and int(codes.max()) >= 1 << (3 * depth):
+            raise ValueError(f"codes must lie in [0, 8**{depth}) for depth {depth}")
         order = None
         if payload:
             order = np.argsort(codes, kind="stable")

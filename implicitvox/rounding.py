@@ -50,8 +50,8 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["down", "up", "down_nonneg", "up_nonneg", "TRANSCENDENTAL_ULPS", "POW_ULPS",
-           "SIN_ULPS", "COS_ULPS", "EPS"]
+__all__ = ["down", "up", "down_nonneg", "up_nonneg", "limits", "TRANSCENDENTAL_ULPS", "POW_ULPS",
+           "SIN_ULPS", "COS_ULPS", "EPS", "LIMITS"]
 
 #: floats of outward widening after numpy's transcendental functions.
 TRANSCENDENTAL_ULPS = 4
@@ -69,40 +69,51 @@ COS_ULPS = 2 * TRANSCENDENTAL_ULPS + 2
 
 #: the spacing of floats at 1 (one ulp of 1.0)
 EPS = 2.0 ** -52
-_EPS = EPS
-_TINY = 2.0 ** -1074
-_MAX = float(np.finfo(np.float64).max)
+#: per float type: (spacing at 1, smallest subnormal, largest finite); the
+#: interval kernels also run on float32 (:mod:`implicitvox.precision`)
+LIMITS = {np.dtype(np.float64): (EPS, 2.0 ** -1074, float(np.finfo(np.float64).max)),
+          np.dtype(np.float32): (2.0 ** -23, 2.0 ** -149, float(np.finfo(np.float32).max))}
+_F64 = LIMITS[np.dtype(np.float64)]
+
+
+def limits(a) -> tuple[float, float, float]:
+    """``(eps, tiny, max)`` of ``a``'s float type (float64 for anything else)."""
+    return LIMITS.get(getattr(a, "dtype", None), _F64)
 
 
 def down(a: np.ndarray, ulps: int = 1) -> np.ndarray:
     """A value at least ``ulps`` floats below ``a`` (``+inf`` -> largest float)."""
     step = np.asanyarray(np.abs(a))  # 0-d for scalars, so the in-place steps work
-    step *= ulps * _EPS
-    step += _TINY
+    eps, tiny, big = limits(step)
+    step *= ulps * eps
+    step += tiny
     with np.errstate(invalid="ignore"):
         out = np.subtract(a, step, out=step)     # inf - inf = NaN only for a = +inf
-    return np.fmin(out, _MAX, out=out)           # NaN -> largest float
+    return np.fmin(out, big, out=out)            # NaN -> largest float
 
 
 def up(a: np.ndarray, ulps: int = 1) -> np.ndarray:
     """A value at least ``ulps`` floats above ``a`` (``-inf`` -> most negative float)."""
     step = np.asanyarray(np.abs(a))
-    step *= ulps * _EPS
-    step += _TINY
+    eps, tiny, big = limits(step)
+    step *= ulps * eps
+    step += tiny
     with np.errstate(invalid="ignore"):
         out = np.add(a, step, out=step)
-    return np.fmax(out, -_MAX, out=out)
+    return np.fmax(out, -big, out=out)
 
 
 def down_nonneg(a: np.ndarray, ulps: int = 1) -> np.ndarray:
     """:func:`down` for ``a >= 0``, clamped at 0 (the result is known non-negative)."""
-    out = np.asanyarray(np.multiply(a, 1.0 - ulps * _EPS))
-    out -= _TINY
-    return np.clip(out, 0.0, _MAX, out=out)
+    eps, tiny, big = limits(a)
+    out = np.asanyarray(np.multiply(a, 1.0 - ulps * eps))
+    out -= tiny
+    return np.clip(out, 0.0, big, out=out)
 
 
 def up_nonneg(a: np.ndarray, ulps: int = 1) -> np.ndarray:
     """:func:`up` for ``a >= 0``."""
-    out = np.multiply(a, 1.0 + ulps * _EPS)
-    out += _TINY
+    eps, tiny, _ = limits(a)
+    out = np.multiply(a, 1.0 + ulps * eps)
+    out += tiny
     return out

@@ -17,6 +17,7 @@ CUBE = ((-1.0,) * 3, (1.0,) * 3)
 @pytest.mark.parametrize("shape, res, options", [
     (sinsin(3, 4), 16, {}), (gear(), 24, {}), (BALL, (10, 7, 12), {}),
     (sinsin(3, 4), 16, {"subvoxel": 1}), (gear(), 16, {"mean_value": True}),
+    (sinsin(9, 18), 16, {"recheck": 0.2}), (gear(), 16, {"recheck": 0.0}),
 ])
 def test_refine_equals_direct_voxelization(shape, res, options):
     bounds = CUBE if shape is BALL else None
@@ -41,6 +42,38 @@ def test_subvoxel_refinement_is_a_subset_and_keeps_the_interior(subvoxel):
     true = 4 / 3 * math.pi * 0.7 ** 3
     v = np.prod(ball.voxel_size)
     assert ball.interior_count * v <= true <= (ball.interior_count + ball.count) * v
+
+
+@pytest.mark.parametrize("shape", [sinsin(3, 4), gear()], ids=["sinsin34", "gear"])
+def test_recheck_of_every_voxel_is_subvoxel_refinement(shape):
+    """A share of 0.5 rechecks every AMBIGUOUS voxel: the same voxels (and
+    interior) as ``subvoxel=1``."""
+    every = ivx.voxelize(shape, resolution=32, interior=True, recheck=0.5)
+    sub = ivx.voxelize(shape, resolution=32, interior=True, subvoxel=1, recheck=0.0)
+    np.testing.assert_array_equal(every.coords(), sub.coords())
+    np.testing.assert_array_equal(every.to_dense(), sub.to_dense())
+
+
+def test_recheck_drops_voxels_into_the_interior_or_outside():
+    """Rechecked voxels only leave the surface: those inside join the interior,
+    the others are empty, as ``f`` at their centres says."""
+    shape = sinsin(3, 4)
+    base = ivx.voxelize(shape, resolution=48, interior=True, recheck=0.0)
+    tight = ivx.voxelize(shape, resolution=48, interior=True, recheck=0.1)
+    assert tight.count < 0.95 * base.count and base.contains(tight.coords()).all()
+    kept = tight.contains(base.coords())
+    dropped = base.coords()[~kept]
+    solid = tight.to_dense()
+    inside = ivx.compile(shape.expr)(*tight.grid.centers(dropped).T) < 0
+    assert inside.any() and (~inside).any()
+    np.testing.assert_array_equal(solid[dropped[:, 0], dropped[:, 1], dropped[:, 2]], inside)
+    np.testing.assert_array_equal(solid & ~base.to_dense(), np.zeros_like(solid))
+
+
+@pytest.mark.parametrize("recheck", [-0.1, 0.6, True, "0.1", float("nan")])
+def test_bad_recheck(recheck):
+    with pytest.raises(ValueError, match="recheck"):
+        ivx.voxelize(BALL, CUBE, 8, recheck=recheck)
 
 
 def test_interior_and_surface_bracket_the_volume():

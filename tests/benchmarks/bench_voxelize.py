@@ -11,7 +11,11 @@ Prints, single process:
    slabs) at the ``--dense`` resolutions, with the speed-up;
 3. tightness at ``--tight-res``: the share of output voxels in which a dense
    sampling (10^3 points on the closed voxel) finds a sign change, for the
-   defaults, ``mean_value=True`` and ``subvoxel=1, 2``.
+   defaults (``recheck=0.02``), ``recheck=0`` (no recheck), ``0.05`` and ``0.1``,
+   ``mean_value=True``, ``subvoxel=1`` and ``mean_value=True, subvoxel=2``.
+
+The interval evaluation runs in float32 for these models at every level
+(:func:`implicitvox.precision.interval_dtype`; the "fp" column).
 """
 from __future__ import annotations
 
@@ -23,6 +27,7 @@ import numpy as np
 import implicitvox as ivx
 from implicitvox.examples import sinsin
 from implicitvox.grid import Grid
+from implicitvox.precision import interval_dtype
 
 MODELS = [(3, 4), (5, 6), (9, 10), (9, 18)]
 
@@ -74,7 +79,7 @@ def main() -> None:
     resolutions = [r for r in (128, 256, 512, 1024, 2048) if r <= args.max_res]
 
     print("== voxelization (defaults, single process) ==")
-    print(f"{'n,m':>6}{'res':>6}{'seconds':>9}{'voxels':>12}{'octree B':>12}{'B/vox':>7}"
+    print(f"{'n,m':>6}{'res':>6}{'fp':>9}{'seconds':>9}{'voxels':>12}{'octree B':>12}{'B/vox':>7}"
           f"{'t x':>6}{'vox x':>7}")
     timings: dict = {}
     for n, m in MODELS:
@@ -87,7 +92,8 @@ def main() -> None:
                 dt = min(dt, time.perf_counter() - t)
             timings[(n, m, res)] = dt
             growth = (f"{dt / prev[0]:6.2f}{vox.count / prev[1]:7.2f}" if prev else " " * 13)
-            print(f"{n},{m:>3}{res:>6}{dt:>9.2f}{vox.count:>12,}{vox.octree.nbytes:>12,}"
+            fp = interval_dtype(ivx.compile(sinsin(n, m).expr).tape, vox.grid).name
+            print(f"{n},{m:>3}{res:>6}{fp:>9}{dt:>9.2f}{vox.count:>12,}{vox.octree.nbytes:>12,}"
                   f"{vox.octree.nbytes / vox.count:>7.2f}{growth}")
             prev = (dt, vox.count)
 
@@ -106,10 +112,11 @@ def main() -> None:
             print(f"{n},{m:>3}{res:>6}{dense_s:>9.2f}{ours:>9.2f}{dense_s / ours:>10.1f}{count:>12,}")
 
     print(f"\n== tightness at {args.tight_res}^3: share of voxels with a sampled sign change ==")
-    variants = [("defaults", {}), ("mean_value", {"mean_value": True}),
-                ("subvoxel=1", {"subvoxel": 1}), ("subvoxel=2", {"subvoxel": 2}),
+    variants = [("defaults", {}), ("recheck=0", {"recheck": 0.0}),
+                ("recheck=0.05", {"recheck": 0.05}), ("recheck=0.1", {"recheck": 0.1}),
+                ("mean_value", {"mean_value": True}), ("subvoxel=1", {"subvoxel": 1}),
                 ("mean+sub=2", {"mean_value": True, "subvoxel": 2})]
-    print(f"{'n,m':>6}" + "".join(f"{name:>20}" for name, _ in variants))
+    print(f"{'n,m':>6}" + "".join(f"{name:>18}" for name, _ in variants))
     for n, m in MODELS:
         func = ivx.compile(sinsin(n, m).expr)
         cells = []
@@ -118,7 +125,7 @@ def main() -> None:
             vox = ivx.voxelize(sinsin(n, m), resolution=args.tight_res, **options)
             dt = time.perf_counter() - t
             cells.append(f"{tightness(func, vox):.3f} ({dt:5.1f}s)")
-        print(f"{n},{m:>3}" + "".join(f"{c:>20}" for c in cells))
+        print(f"{n},{m:>3}" + "".join(f"{c:>18}" for c in cells))
 
 
 if __name__ == "__main__":
