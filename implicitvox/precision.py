@@ -53,7 +53,7 @@ VOXEL_IN_ULPS = 1024
 def exact_in_float32(value: float) -> bool:
     """Does float32 hold ``value`` exactly (finite)?"""
     v = float(value)
-    return bool(np.isfinite(v)) and float(np.float32(v)) == v
+    return _in_range(v) and float(np.float32(v)) == v
 
 
 def float32_bounds(value: float) -> tuple[np.float32, np.float32]:
@@ -65,18 +65,28 @@ def float32_bounds(value: float) -> tuple[np.float32, np.float32]:
     return np.float32(lo), np.float32(hi)
 
 
+#: constants beyond this magnitude keep a tape in float64 (float32 ends at 3.4e38)
+LARGEST_CONSTANT = 1e30
+
+
+def _in_range(value: float) -> bool:
+    return bool(np.isfinite(value)) and abs(float(value)) <= LARGEST_CONSTANT
+
+
 def _params_fit(op: str, param) -> bool:
     if op == "periodic_angle":
         _, k, c = param
         return exact_in_float32(k) and exact_in_float32(c)
     if op == "distance":
         return all(exact_in_float32(c) for c in param)
+    if op in CONSTANT_OPERAND:
+        return _in_range(param)
     return True
 
 
 def supports_float32(tape: Tape) -> bool:
     """Can every instruction of ``tape`` run in float32 (see the module)?"""
-    if tape.undefined or not all(np.isfinite([c.lo, c.hi]).all() for c in tape.constants):
+    if tape.undefined or not all(_in_range(c.lo) and _in_range(c.hi) for c in tape.constants):
         return False
     return all(ins.op.name in FLOAT32_OPS and _params_fit(ins.op.name, ins.param)
                for ins in tape.instructions)

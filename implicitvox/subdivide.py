@@ -297,7 +297,7 @@ def subdivide(func: Function, grid: Grid, *, start: Optional[tuple[int, np.ndarr
         Tighten AMBIGUOUS octants with the mean value form.
     recheck : float, default: RECHECK
         Voxels whose enclosure holds 0 within this share of its width from an
-        end are rechecked on their 8 sub-voxels (:func:`_recheck`); 0 turns it
+        end are rechecked on their 8 sub-voxels (:func:`recheck_voxels`); 0 turns it
         off, 0.5 rechecks every voxel (as ``subvoxel=1`` does).
     """
     depth = grid.depth

@@ -122,6 +122,9 @@ def test_float32_is_chosen_only_where_allowed():
     # an operation without a float32 kernel keeps the tape in float64
     assert not supports_float32(ivx.compile(ivx.tan(ivx.x) - ivx.y).tape)
     assert not supports_float32(ivx.compile(ivx.log(ivx.x + 2) - ivx.y).tape)
+    # constants past float32's range (3.4e38) too; exact ones and intervals of two fit
+    assert not supports_float32(ivx.compile(ivx.x * 1e35 - ivx.y).tape)
+    assert supports_float32(ivx.compile(ivx.x * 0.1 + 0.3 - ivx.y).tape)
 
 
 TORUS = ExprShape((cylindrical(axis="z").rho - 0.6) ** 2 + ivx.z ** 2 - 0.12 ** 2,
