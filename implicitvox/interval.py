@@ -66,7 +66,7 @@ INF = np.inf
 PI_UP = float(np.nextafter(np.pi, INF))
 HALF_PI_UP = float(np.nextafter(np.pi / 2, INF))
 _TWO_PI = 2.0 * np.pi
-_TINY = 2.0 ** -1074
+_TINY = R.LIMITS[np.dtype(np.float64)][1]   # the smallest subnormal double
 
 
 def mignitude(lo, hi):
@@ -423,9 +423,9 @@ def i_radius(ulo, uhi, vlo, vhi, wlo, whi):
 _SQRT_MAX_DOWN = float(np.sqrt(np.finfo(np.float64).max)) * (1.0 - 2.0 ** -48)
 #: above every rounding error that underflowing squares leave after the root
 _UNDERFLOW_ROOT = 2.0 ** -536
-#: (eps, underflow root, sqrt max down) by float type (float32: squares lose 2**-150)
-_DISTANCE_LIMITS = {False: (R.EPS, _UNDERFLOW_ROOT, _SQRT_MAX_DOWN),
-                    True: (2.0 ** -23, 2.0 ** -74,
+#: (underflow root, sqrt max down) by float type (float32: squares lose 2**-150)
+_DISTANCE_LIMITS = {False: (_UNDERFLOW_ROOT, _SQRT_MAX_DOWN),
+                    True: (2.0 ** -74,
                            float(np.sqrt(np.float64(np.finfo(np.float32).max))) * (1.0 - 2.0 ** -20))}
 
 
@@ -463,7 +463,8 @@ def i_distance(alo, ahi, blo, bhi, wlo, whi, centre):
     n1, f1 = _offset_square_extents(blo, bhi, c1)
     n2, f2 = _offset_square_extents(wlo, whi, c2)
     near, far = np.sqrt((n0 + n1) + n2), np.sqrt((f0 + f1) + f2)
-    eps, underflow_root, sqrt_max_down = _DISTANCE_LIMITS[near.dtype == np.float32]
+    eps = R.limits(near)[0]
+    underflow_root, sqrt_max_down = _DISTANCE_LIMITS[near.dtype == np.float32]
     lo = near * (1.0 - 3.0 * eps) - underflow_root
     hi = far * (1.0 + 3.0 * eps) + underflow_root
     return np.clip(lo, 0.0, sqrt_max_down), hi
