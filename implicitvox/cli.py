@@ -127,9 +127,9 @@ def _parser() -> argparse.ArgumentParser:
                      help="tighter: mean value form on ambiguous octants (about 3x the time)")
     vox.add_argument("--subvoxel", type=int, default=0, metavar="K",
                      help="tighter: keep a voxel only if a sub-voxel K levels down is ambiguous")
-    vox.add_argument("--recheck", type=float, default=RECHECK, metavar="SHARE",
-                     help="recheck on sub-voxels the voxels whose interval holds 0 within this "
-                          f"share of an end (default {RECHECK}; 0 = off)")
+    vox.add_argument("--recheck", type=float, default=RECHECK, metavar="STRENGTH",
+                     help="recheck on sub-voxels the voxels predicted to be false "
+                          f"(default {RECHECK}; 0 = off, up to 4 = nearly all)")
     vox.add_argument("--out", help="write .npz, .vti or .binvox")
     vox.add_argument("--render", metavar="PNG", help="render a picture")
     vox.add_argument("--max-memory", type=float, metavar="GIB", help="refuse runs estimated above")

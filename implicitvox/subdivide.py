@@ -36,12 +36,15 @@ from .mean_value import mean_value_enclosure
 from .precision import interval_dtype, level_dtype, supports_float32
 from .shape import AMBIGUOUS, EMPTY, FULL
 
-__all__ = ["subdivide", "Subdivision", "classify", "CHUNK", "RECHECK"]
+__all__ = ["subdivide", "Subdivision", "classify", "suspect_voxels", "recheck_voxels", "CHUNK",
+           "RECHECK"]
 
 #: octants classified per interval evaluation
 CHUNK = 1 << 17
-#: default share for :func:`_recheck` (measured in tests/benchmarks/bench_voxelize.py)
-RECHECK = 0.02
+#: default strength of the recheck (:func:`suspect_voxels`; measured in
+#: tests/benchmarks/bench_voxelize.py): 1/4 selects the voxels whose sub-voxels
+#: are predicted to settle them
+RECHECK = 0.25
 _CHILD_OFFSETS = np.array([[c & 1, (c >> 1) & 1, (c >> 2) & 1] for c in range(8)], dtype=np.int32)
 
 
@@ -166,7 +169,7 @@ def _child_states(func: Function, grid: Grid, level: int, parents: np.ndarray, d
     if inside is not None:
         state *= inside
         classified = int(np.count_nonzero(inside))
-    return state, flo, fhi, classified
+    return state, flo, fhi, classified, inside
 
 
 def classify_children(func: Function, grid: Grid, level: int, parents: np.ndarray,
@@ -179,13 +182,13 @@ def classify_children(func: Function, grid: Grid, level: int, parents: np.ndarra
     interval evaluation for all children (see :func:`_child_boxes`), in
     ``dtype``; the mean value form and the exact test then run on the
     AMBIGUOUS ones, as in :func:`classify`. At the voxel level, without an
-    exact test, the AMBIGUOUS children whose enclosure holds 0 within
-    ``recheck`` of its width from an end are *suspects* (see
-    :func:`recheck_voxels`), returned apart. Returns ``(ambiguous, full,
+    exact test, the AMBIGUOUS children that :func:`suspect_voxels` picks
+    (``recheck`` > 0) are *suspects* (see :func:`recheck_voxels`), returned
+    apart. Returns ``(ambiguous, full,
     suspects, classified)``: ``full`` None unless asked for, ``classified``
     the number of boxes classified.
     """
-    state, flo, fhi, classified = _child_states(func, grid, level, parents, dtype)
+    state, flo, fhi, classified, inside = _child_states(func, grid, level, parents, dtype)
     kids = ((parents << _THREE)[None, :] | _SLOTS[:, None]).reshape(-1)
     if mean_value or exact is not None:
         amb = np.flatnonzero(state == AMBIGUOUS)
@@ -197,7 +200,7 @@ def classify_children(func: Function, grid: Grid, level: int, parents: np.ndarra
     ambiguous = state == AMBIGUOUS
     suspects = _NONE
     if recheck > 0.0 and exact is None and level + 1 == grid.depth:
-        near_end = np.minimum(-flo, fhi) <= recheck * (fhi - flo)
+        near_end = suspect_voxels(flo, fhi, len(parents), recheck, inside)
         near_end &= ambiguous
         suspects = kids[np.flatnonzero(near_end)]
         ambiguous &= ~near_end
@@ -208,15 +211,58 @@ def classify_children(func: Function, grid: Grid, level: int, parents: np.ndarra
 _NONE = np.zeros(0, dtype=np.uint64)
 
 
+def suspect_voxels(flo: np.ndarray, fhi: np.ndarray, m: int, recheck: float,
+                   inside: Optional[np.ndarray] = None) -> np.ndarray:
+    """Which voxels (the ``8 m`` children of ``m`` octants, child-major, with
+    enclosures ``[flo, fhi]``) to recheck on their sub-voxels.
+
+    A natural interval enclosure of width ``W`` overestimates the true range
+    ``w`` of ``f`` over a voxel (by the triangle inequality, where the terms of
+    ``f`` partly cancel; Stolte §1). The 8 children of one octant sit on a
+    2 x 2 x 2 lattice one voxel apart, so the spread of their enclosures'
+    midpoints (each ``f`` at a child centre, to second order) estimates ``w``
+    without further evaluation: ``rho = spread / W`` (for linear ``f``, exactly
+    ``w / W``). A sub-voxel's enclosure is about ``W / 2`` wide and centred up
+    to ``w / 4`` nearer 0 than the voxel's midpoint ``c``, so all 8 exclude 0
+    when ``|c| > (W + w) / 4``: when 0 lies within ``(1 - rho) / 4`` of the
+    width from an end. A voxel is a suspect when 0 lies within ``recheck (1 -
+    rho) W`` of an end: ``recheck = 1/4`` is the prediction itself, larger
+    values recheck more. Children outside the grid (``inside`` False) do not
+    count in the spread. For affine ``f`` the prediction is exact
+    (``tests/test_voxelize.py``).
+
+    Examples
+    --------
+    One octant whose 8 children have enclosures of width 1 and midpoints
+    spread over 0.49 (``rho = 0.49``): the suspects are those with 0 within
+    ``0.25 * 0.51`` of an end.
+
+    >>> import numpy as np
+    >>> mid = np.array([0.0, 0.1, 0.2, 0.3, 0.4, 0.45, 0.48, 0.49])
+    >>> suspect_voxels(mid - 0.5, mid + 0.5, 1, 0.25)
+    array([False, False, False, False,  True,  True,  True,  True])
+    """
+    with np.errstate(invalid="ignore"):
+        twice_mid = (flo + fhi).reshape(8, m)
+        if inside is not None:
+            twice_mid[~inside.reshape(8, m)] = np.nan
+        spread = np.fmax.reduce(twice_mid, axis=0)          # fmax, fmin: NaN ignored
+        spread -= np.fmin.reduce(twice_mid, axis=0)
+        spread *= 0.5
+        margin = fhi - flo
+        margin.reshape(8, m)[...] -= spread
+        margin *= recheck
+        return np.minimum(-flo, fhi) <= margin
+
+
 def recheck_voxels(func: Function, grid: Grid, codes: np.ndarray, dtype
                    ) -> tuple[np.ndarray, np.ndarray, int]:
     """Settle suspect voxels (Morton codes at ``grid.depth``) on their 8 sub-voxels.
 
-    A voxel whose enclosure ``[flo, fhi]`` holds 0 within a small share of
-    its width from an end is most likely not met by the surface: the
-    enclosure overestimates the range by about a constant factor (natural
-    interval extensions converge linearly, Stolte §2), and here the excess
-    alone reaches 0. Its 8 halves, being smaller, get tighter enclosures: it
+    A suspect (:func:`suspect_voxels`) is a voxel whose enclosure reaches 0
+    only by the amount it overestimates the range of ``f`` (natural
+    interval extensions converge linearly, Stolte §2), as predicted from its
+    siblings. Its 8 halves, being smaller, get tighter enclosures: it
     stays AMBIGUOUS if one of them is, and is FULL (EMPTY) if all are, since
     any two halves share a point and a FULL one cannot touch an EMPTY one.
     This is ``subvoxel=1`` (Stolte's sub-voxel refinement) on the few voxels
@@ -225,7 +271,7 @@ def recheck_voxels(func: Function, grid: Grid, codes: np.ndarray, dtype
     """
     fine = grid.finer(1)
     sub_dtype = level_dtype(fine, fine.depth) if np.dtype(dtype) == np.float32 else np.float64
-    state, _, _, classified = _child_states(func, fine, grid.depth, codes, sub_dtype)
+    state, _, _, classified, _ = _child_states(func, fine, grid.depth, codes, sub_dtype)
     state = state.reshape(8, -1)
     met = (state == AMBIGUOUS).any(axis=0)
     inside = (state == FULL).all(axis=0)
@@ -296,9 +342,8 @@ def subdivide(func: Function, grid: Grid, *, start: Optional[tuple[int, np.ndarr
     mean_value : bool, default: False
         Tighten AMBIGUOUS octants with the mean value form.
     recheck : float, default: RECHECK
-        Voxels whose enclosure holds 0 within this share of its width from an
-        end are rechecked on their 8 sub-voxels (:func:`recheck_voxels`); 0 turns it
-        off, 0.5 rechecks every voxel (as ``subvoxel=1`` does).
+        Strength of the recheck of suspect voxels on their 8 sub-voxels
+        (:func:`suspect_voxels`, :func:`recheck_voxels`); 0 turns it off.
     """
     depth = grid.depth
     per_step = max(1, chunk // 8)

@@ -67,7 +67,8 @@ def estimate_memory(func: Function, grid: Grid, normals: bool = False) -> tuple[
     pilot = Grid(grid.origin, tuple(h * scale for h in grid.voxel_size),
                  tuple(-(-n // scale) for n in grid.shape))
     # The pilot's voxels are unions of grid voxels; crop effects are ignored.
-    found = len(subdivide(func, pilot).codes)
+    # No recheck: the pilot is cheaper and its count an upper estimate.
+    found = len(subdivide(func, pilot, recheck=0.0).codes)
     voxels = found * 4 ** (depth - pilot_depth)
     per_voxel = _BYTES_PER_VOXEL + (_BYTES_PER_NORMAL if normals else 0)
     working = 8 * (1 << 17) * max(depth, 1) * 64  # chunks on the stack, interval arrays
@@ -124,11 +125,14 @@ def voxelize(shape: Any, bounds: Any = None, resolution: Union[int, tuple[int, i
         Sub-voxel refinement: keep a voxel only if one of its ``8**subvoxel``
         sub-voxels stays AMBIGUOUS. Tighter (never a miss), about
         ``4**subvoxel`` times the work.
-    recheck : float, default: 0.02
+    recheck : float, default: 0.25
         Sub-voxel refinement for the suspect voxels alone: those whose
-        enclosure holds 0 within this share of its width from an end, nearly
-        all of which the surface misses. 0 turns it off; 0.05 rechecks about
-        10% of the voxels. Ignored for shapes with an exact voxel test.
+        enclosure reaches 0 only by the amount it overestimates ``f``, as
+        estimated from the voxel's siblings
+        (:func:`implicitvox.subdivide.suspect_voxels`). 0.25 rechecks the
+        voxels predicted to be settled (about 10% of them, adding about 25%
+        to the time); larger values recheck more, up to nearly all at 4; 0
+        turns it off. Ignored for shapes with an exact voxel test.
 
     Returns
     -------
@@ -152,8 +156,8 @@ def voxelize(shape: Any, bounds: Any = None, resolution: Union[int, tuple[int, i
             or not 0 <= subvoxel <= 4:
         raise ValueError(f"subvoxel must be an int from 0 to 4, got {subvoxel!r}")
     if isinstance(recheck, bool) or not isinstance(recheck, (int, float, np.floating)) \
-            or not 0.0 <= recheck <= 0.5:
-        raise ValueError(f"recheck must be a share from 0 to 0.5, got {recheck!r}")
+            or not 0.0 <= recheck <= 4.0:
+        raise ValueError(f"recheck must be a number from 0 to 4, got {recheck!r}")
     grid = Grid.from_bounds(bounds, resolution)
     if grid.depth + subvoxel > 21:
         raise ValueError(f"resolution {grid.shape} with subvoxel={subvoxel} exceeds the octree's "

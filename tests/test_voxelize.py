@@ -44,14 +44,39 @@ def test_subvoxel_refinement_is_a_subset_and_keeps_the_interior(subvoxel):
     assert ball.interior_count * v <= true <= (ball.interior_count + ball.count) * v
 
 
+#: affine, with the dependency the natural extension overestimates (3x - 2x: width 5h, not h)
+AFFINE = 3 * x - 2 * x + 0.7 * y - 0.45 * y + 0.2 * z - 0.3137
+
+
+@pytest.mark.parametrize("res", [32, 64, (24, 20, 28)])
+def test_recheck_prediction_is_exact_for_affine_functions(res):
+    """For affine ``f`` the siblings' spread is the true range and the
+    sub-voxel enclosures are what :func:`suspect_voxels` predicts, so
+    ``recheck=0.25`` rechecks exactly the voxels that sub-voxels settle: the
+    result of ``subvoxel=1``, at a fraction of its work; 0.2 misses some."""
+    exact = ivx.voxelize(AFFINE, CUBE, res, interior=True, recheck=0.25)
+    sub = ivx.voxelize(AFFINE, CUBE, res, interior=True, subvoxel=1, recheck=0.0)
+    base = ivx.voxelize(AFFINE, CUBE, res, interior=True, recheck=0.0)
+    assert sub.count < 0.7 * base.count
+    np.testing.assert_array_equal(exact.coords(), sub.coords())
+    np.testing.assert_array_equal(exact.to_dense(), sub.to_dense())
+    assert ivx.voxelize(AFFINE, CUBE, res, recheck=0.2).count > exact.count
+
+
 @pytest.mark.parametrize("shape", [sinsin(3, 4), gear()], ids=["sinsin34", "gear"])
-def test_recheck_of_every_voxel_is_subvoxel_refinement(shape):
-    """A share of 0.5 rechecks every AMBIGUOUS voxel: the same voxels (and
-    interior) as ``subvoxel=1``."""
-    every = ivx.voxelize(shape, resolution=32, interior=True, recheck=0.5)
-    sub = ivx.voxelize(shape, resolution=32, interior=True, subvoxel=1, recheck=0.0)
-    np.testing.assert_array_equal(every.coords(), sub.coords())
-    np.testing.assert_array_equal(every.to_dense(), sub.to_dense())
+def test_recheck_lies_between_subvoxel_refinement_and_none(shape):
+    """A stronger recheck drops a superset of voxels, and never one that
+    ``subvoxel=1`` keeps; at 4 nearly every voxel is rechecked."""
+    counts = []
+    sub = ivx.voxelize(shape, resolution=32, subvoxel=1, recheck=0.0)
+    previous = ivx.voxelize(shape, resolution=32, recheck=0.0)
+    for strength in (0.1, 0.25, 1.0, 4.0):
+        vox = ivx.voxelize(shape, resolution=32, recheck=strength)
+        assert previous.contains(vox.coords()).all()
+        assert vox.contains(sub.coords()).all()
+        counts.append(vox.count)
+        previous = vox
+    assert counts[0] > counts[-1] and counts[-1] <= 1.01 * sub.count
 
 
 def test_recheck_drops_voxels_into_the_interior_or_outside():
@@ -59,7 +84,7 @@ def test_recheck_drops_voxels_into_the_interior_or_outside():
     the others are empty, as ``f`` at their centres says."""
     shape = sinsin(3, 4)
     base = ivx.voxelize(shape, resolution=48, interior=True, recheck=0.0)
-    tight = ivx.voxelize(shape, resolution=48, interior=True, recheck=0.1)
+    tight = ivx.voxelize(shape, resolution=48, interior=True, recheck=0.5)
     assert tight.count < 0.95 * base.count and base.contains(tight.coords()).all()
     kept = tight.contains(base.coords())
     dropped = base.coords()[~kept]
@@ -70,7 +95,7 @@ def test_recheck_drops_voxels_into_the_interior_or_outside():
     np.testing.assert_array_equal(solid & ~base.to_dense(), np.zeros_like(solid))
 
 
-@pytest.mark.parametrize("recheck", [-0.1, 0.6, True, "0.1", float("nan")])
+@pytest.mark.parametrize("recheck", [-0.1, 4.5, True, "0.1", float("nan")])
 def test_bad_recheck(recheck):
     with pytest.raises(ValueError, match="recheck"):
         ivx.voxelize(BALL, CUBE, 8, recheck=recheck)
