@@ -38,7 +38,8 @@ def evaluate_intervals(tape: Tape, lo: tuple[np.ndarray, np.ndarray, np.ndarray]
     dtype : float64 or float32
         What the kernels compute in. float32 (only for tapes that
         :func:`implicitvox.precision.interval_dtype` allows) rounds the boxes
-        outward to float32 first; the enclosures are returned as float64.
+        outward to float32 first (bounds already in float32 are taken as they
+        are); the enclosures are returned as float64.
 
     Returns
     -------
@@ -50,8 +51,9 @@ def evaluate_intervals(tape: Tape, lo: tuple[np.ndarray, np.ndarray, np.ndarray]
     per_column = max(1, int(np.prod(shape[:-1], dtype=np.int64))) if shape else 1
     step = max(1, CHUNK // per_column)
     single = np.dtype(dtype) == np.float32
-    if single:
-        lo, hi = zip(*(outward_float32(a, b) for a, b in zip(lo, hi)))
+    if single:   # float32 bounds are exact as they are
+        lo, hi = zip(*((a, b) if _is_float32(a) and _is_float32(b) else outward_float32(a, b)
+                       for a, b in zip(lo, hi)))
     if columns > step:
         parts = [_evaluate(tape, tuple(c[..., s:s + step] for c in lo),
                            tuple(c[..., s:s + step] for c in hi), single)
@@ -59,6 +61,10 @@ def evaluate_intervals(tape: Tape, lo: tuple[np.ndarray, np.ndarray, np.ndarray]
         return (np.concatenate([p[0] for p in parts], axis=-1),
                 np.concatenate([p[1] for p in parts], axis=-1))
     return _evaluate(tape, lo, hi, single)
+
+
+def _is_float32(a) -> bool:
+    return getattr(a, "dtype", None) == np.float32
 
 
 def apply_op(op, param, lo: tuple, hi: tuple, single: bool = False):

@@ -24,6 +24,7 @@ faster, still rounded outward).
 """
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass, field
 from typing import Any, Callable, Optional
 
@@ -33,7 +34,7 @@ from .function import Function
 from .grid import Grid
 from . import morton
 from .mean_value import mean_value_enclosure
-from .precision import interval_dtype, level_dtype, supports_float32
+from .precision import interval_dtype, level_dtype, outward_float32, supports_float32
 from .shape import AMBIGUOUS, EMPTY, FULL
 
 __all__ = ["subdivide", "Subdivision", "classify", "suspect_voxels", "recheck_voxels", "CHUNK",
@@ -135,24 +136,42 @@ def _unpack(keys: np.ndarray) -> np.ndarray:
     return morton.decode(keys).astype(np.int32)
 
 
-def _child_boxes(grid: Grid, level: int, parents: tuple[np.ndarray, ...]):
+def _child_boxes(grid: Grid, level: int, parents: tuple[np.ndarray, ...], single: bool = False):
     """Per-axis bounds of the children of octants ``parents`` (per-axis
     coordinates), shaped to broadcast: ``x (1, 1, 2, m)``, ``y (1, 2, 1, m)``,
     ``z (2, 1, 1, m)``; the (2, 2, 2, m) result reshapes to ``(8, m)`` in
     child order ``x + 2y + 4z``. Children past the grid get degenerate boxes
-    on its edge (they are dropped after)."""
-    scale = float(1 << (grid.depth - level - 1))
+    on its edge (they are dropped after). ``single``: float32 bounds rounded
+    outward, looked up in :func:`_edges32` (the same values
+    :func:`implicitvox.precision.outward_float32` gives the float64 ones)."""
+    scale = 1 << (grid.depth - level - 1)
     lo, hi = [], []
     for a in range(3):
-        first = (parents[a][None, :].astype(np.float64) * 2.0 + _HALVES) * scale
+        first = (parents[a][None, :].astype(np.int64) * 2 + _HALVES) * scale
         last = np.minimum(first + scale, grid.shape[a])
         first = np.minimum(first, grid.shape[a])
-        lo.append(grid.edge(a, first).reshape(_BROADCAST[a]))
-        hi.append(grid.edge(a, last).reshape(_BROADCAST[a]))
+        if single and grid.shape[a] < _EDGE_TABLE_LIMIT:
+            down, up = _edges32(grid, a)
+            lo.append(down[first].reshape(_BROADCAST[a]))
+            hi.append(up[last].reshape(_BROADCAST[a]))
+        else:
+            lo.append(grid.edge(a, first).reshape(_BROADCAST[a]))
+            hi.append(grid.edge(a, last).reshape(_BROADCAST[a]))
     return tuple(lo), tuple(hi)
 
 
-_HALVES = np.array([[0.0], [1.0]])
+_HALVES = np.array([[0], [1]], dtype=np.int64)
+#: voxels per axis up to which the float32 edges are tabulated (256 KiB per table)
+_EDGE_TABLE_LIMIT = 1 << 16
+
+
+@functools.lru_cache(maxsize=16)
+def _edges32(grid: Grid, axis: int) -> tuple[np.ndarray, np.ndarray]:
+    """The voxel edges of ``grid`` along ``axis`` (:meth:`Grid.edge`) rounded
+    down and up to float32: one gather per box end instead of the float64
+    arithmetic and its outward rounding."""
+    edges = grid.edge(axis, np.arange(grid.shape[axis] + 1))
+    return outward_float32(edges, edges)
 
 
 def _child_states(func: Function, grid: Grid, level: int, parents: np.ndarray, dtype):
@@ -160,7 +179,7 @@ def _child_states(func: Function, grid: Grid, level: int, parents: np.ndarray, d
     ``level``, child-major, EMPTY past the grid; and their bounds (8 m) and
     the number of children inside the grid."""
     axes = _axes(parents)
-    lo, hi = _child_boxes(grid, level, axes)
+    lo, hi = _child_boxes(grid, level, axes, single=np.dtype(dtype) == np.float32)
     flo, fhi = func.interval_columns(lo, hi, dtype)
     flo, fhi = flo.reshape(-1), fhi.reshape(-1)     # child-major: index = child * m + parent
     state = _states(flo, fhi)

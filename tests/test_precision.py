@@ -109,6 +109,23 @@ def test_outward_float32_holds_the_box(a, b):
     assert float(below) <= lo <= float(above)
 
 
+@pytest.mark.parametrize("resolution, level", [(64, 4), ((100, 37, 70), 5), (64, 0)])
+def test_tabulated_float32_child_boxes_are_the_rounded_float64_ones(resolution, level):
+    """The subdivision looks the float32 child bounds up in a table of rounded
+    edges: the same bounds as rounding the float64 ones, past the grid too."""
+    grid = Grid.from_bounds(((-1.1, -0.3, 0.1), (1.3, 0.7, 2.0)), resolution)
+    n = 1 << level
+    axes = tuple(np.arange(n, dtype=np.uint32)[np.random.default_rng(level).integers(0, n, 500)]
+                 for _ in range(3))
+    lo32, hi32 = subdivision._child_boxes(grid, level, axes, single=True)
+    lo64, hi64 = subdivision._child_boxes(grid, level, axes)
+    for a in range(3):
+        want_lo, want_hi = outward_float32(lo64[a], hi64[a])
+        assert lo32[a].dtype == np.float32 and hi32[a].dtype == np.float32
+        np.testing.assert_array_equal(lo32[a], want_lo)
+        np.testing.assert_array_equal(hi32[a], want_hi)
+
+
 def test_float32_is_chosen_only_where_allowed():
     tape = ivx.compile(sinsin(9, 18).expr).tape
     assert supports_float32(tape)
