@@ -203,9 +203,8 @@ def classify_children(func: Function, grid: Grid, level: int, parents: np.ndarra
     AMBIGUOUS ones, as in :func:`classify`. At the voxel level, without an
     exact test, the AMBIGUOUS children that :func:`suspect_voxels` picks
     (``recheck`` > 0) are *suspects* (see :func:`recheck_voxels`), returned
-    apart. Returns ``(ambiguous, full,
-    suspects, classified)``: ``full`` None unless asked for, ``classified``
-    the number of boxes classified.
+    apart. Returns ``(ambiguous, full, suspects, classified)``: ``full`` None
+    unless asked for, ``classified`` the number of boxes classified.
     """
     state, flo, fhi, classified, inside = _child_states(func, grid, level, parents, dtype)
     kids = ((parents << _THREE)[None, :] | _SLOTS[:, None]).reshape(-1)
