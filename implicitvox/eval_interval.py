@@ -54,12 +54,13 @@ def evaluate_intervals(tape: Tape, lo: tuple[np.ndarray, np.ndarray, np.ndarray]
     if single:   # float32 bounds are exact as they are
         lo, hi = zip(*((a, b) if _is_float32(a) and _is_float32(b) else outward_float32(a, b)
                        for a, b in zip(lo, hi)))
-    if columns > step:
-        parts = [_evaluate(tape, tuple(c[..., s:s + step] for c in lo),
-                           tuple(c[..., s:s + step] for c in hi), single)
-                 for s in range(0, columns, step)]
-        return (np.concatenate([p[0] for p in parts], axis=-1),
-                np.concatenate([p[1] for p in parts], axis=-1))
+    if columns > step:   # in passes of `step` columns, written into the result
+        flo, fhi = np.empty(shape), np.empty(shape)
+        for s in range(0, columns, step):
+            part = np.s_[..., s:s + step]
+            _evaluate(tape, tuple(c[part] for c in lo), tuple(c[part] for c in hi), single,
+                      out=(flo[part], fhi[part]))
+        return flo, fhi
     return _evaluate(tape, lo, hi, single)
 
 
@@ -81,10 +82,13 @@ def apply_op(op, param, lo: tuple, hi: tuple, single: bool = False):
     return op.interval(lo, hi, param)
 
 
-def _evaluate(tape, lo, hi, single=False):
+def _evaluate(tape, lo, hi, single=False, out=None):
+    """The enclosures over one pass of boxes, as new float64 arrays or into ``out``."""
     shape = np.broadcast_shapes(*(a.shape for a in lo), *(a.shape for a in hi))
+    flo, fhi = (np.empty(shape), np.empty(shape)) if out is None else out
     if tape.undefined:
-        return np.full(shape, np.inf), np.full(shape, -np.inf)
+        flo[...], fhi[...] = np.inf, -np.inf
+        return flo, fhi
     rlo: list = [None] * tape.n_registers
     rhi: list = [None] * tape.n_registers
     for axis, name in enumerate("xyz"):
@@ -105,8 +109,8 @@ def _evaluate(tape, lo, hi, single=False):
                 result, lane_empty = result[:2], result[2]
                 empty = lane_empty if empty is None else (empty | lane_empty)
             rlo[ins.out], rhi[ins.out] = result
-    flo = np.array(np.broadcast_to(rlo[tape.output], shape), dtype=np.float64)
-    fhi = np.array(np.broadcast_to(rhi[tape.output], shape), dtype=np.float64)
+    np.copyto(flo, rlo[tape.output])   # broadcast and cast to float64
+    np.copyto(fhi, rhi[tape.output])
     if empty is not None:
         empty = np.broadcast_to(empty, shape)
         flo[empty] = np.inf

@@ -50,6 +50,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from .filled import filled_like
+
 __all__ = ["down", "up", "down_nonneg", "up_nonneg", "limits", "TRANSCENDENTAL_ULPS", "POW_ULPS",
            "SIN_ULPS", "COS_ULPS", "EPS", "LIMITS"]
 
@@ -89,7 +91,7 @@ def down(a: np.ndarray, ulps: int = 1) -> np.ndarray:
     step += tiny
     with np.errstate(invalid="ignore"):
         out = np.subtract(a, step, out=step)     # inf - inf = NaN only for a = +inf
-    return np.fmin(out, big, out=out)            # NaN -> largest float
+    return np.fmin(out, filled_like(big, out), out=out)   # NaN -> largest float
 
 
 def up(a: np.ndarray, ulps: int = 1) -> np.ndarray:
@@ -100,7 +102,7 @@ def up(a: np.ndarray, ulps: int = 1) -> np.ndarray:
     step += tiny
     with np.errstate(invalid="ignore"):
         out = np.add(a, step, out=step)
-    return np.fmax(out, -big, out=out)
+    return np.fmax(out, filled_like(-big, out), out=out)
 
 
 def down_nonneg(a: np.ndarray, ulps: int = 1) -> np.ndarray:

@@ -148,8 +148,10 @@ def _child_boxes(grid: Grid, level: int, parents: tuple[np.ndarray, ...], single
     lo, hi = [], []
     for a in range(3):
         first = (parents[a][None, :].astype(np.int64) * 2 + _HALVES) * scale
-        last = np.minimum(first + scale, grid.shape[a])
-        first = np.minimum(first, grid.shape[a])
+        last = first + scale
+        if grid.shape[a] < 1 << grid.depth:   # children may lie past the grid
+            last = np.minimum(last, grid.shape[a])
+            first = np.minimum(first, grid.shape[a])
         if single and grid.shape[a] < _EDGE_TABLE_LIMIT:
             down, up = _edges32(grid, a)
             lo.append(down[first].reshape(_BROADCAST[a]))
