@@ -72,11 +72,14 @@ _TINY = R.LIMITS[np.dtype(np.float64)][1]   # the smallest subnormal double
 
 def where_set(mask, value: float, a, owned: bool = False):
     """``np.where(mask, value, a)``, computed by putting ``value`` into a copy of
-    ``a`` (into ``a`` itself if ``owned``): the same values, several times
-    faster when few lanes are set, as for the extrema and cuts of small boxes."""
+    ``a`` (into ``a`` itself if ``owned``) at the indices where ``mask``
+    holds: the same values, several times faster when few lanes are set, as
+    for the extrema and cuts of small boxes (``np.where`` and masked copies
+    run a branch per lane)."""
     if isinstance(a, np.ndarray) and a.ndim and a.shape == np.shape(mask):
-        out = a if owned else a.copy()
-        np.copyto(out, value, where=mask)
+        out = a if owned and a.flags.c_contiguous else np.array(a, order="C")
+        if mask.any():
+            out.reshape(-1)[np.flatnonzero(mask)] = value
         return out
     return np.where(mask, value, a)
 
@@ -309,6 +312,19 @@ def cos_values(a):
     return np.where(np.abs(t) > 1.0, near_zero, near_one)
 
 
+def _extremum_flag(q_lo, q_hi, phase: float):
+    """``>= 1`` where ``[q_lo, q_hi]`` (in periods, see :func:`_holds_phase`)
+    holds a point ``u`` with ``u - phase`` an integer, ``<= -1`` where not,
+    NaN (an infinite end) where every phase is held: as arithmetic, so that
+    ``fmin``/``fmax`` apply it without a mask. ``floor(q_hi - phase) -
+    ceil(q_lo - phase)`` is the number of such points less one, an integer."""
+    flag = np.floor(q_hi - phase)
+    flag -= np.ceil(q_lo - phase)
+    flag *= 2.0
+    flag += 1.0
+    return flag
+
+
 def _periodic(alo, ahi, fast, numpy_values, ulps: int, max_phase: float, min_phase: float):
     """``sin`` or ``cos`` over intervals: the end values, and 1 or -1 where an
     extremum lies inside. float64 ends come from ``fast`` (tangents, widened by
@@ -318,17 +334,23 @@ def _periodic(alo, ahi, fast, numpy_values, ulps: int, max_phase: float, min_pha
     with np.errstate(invalid="ignore", divide="ignore"):
         fa, fb = (numpy_values(alo), numpy_values(ahi)) if single else (fast(alo), fast(ahi))
         q_lo, q_hi = _in_periods(alo, ahi, _TWO_PI)
-        has_max = _holds_phase(q_lo, q_hi, max_phase)
-        has_min = _holds_phase(q_lo, q_hi, min_phase)
+        top = _extremum_flag(q_lo, q_hi, max_phase)
+        bottom = _extremum_flag(q_lo, q_hi, min_phase)
     if single:
         lo, hi = R.down(np.fmin(fa, fb), T), R.up(np.fmax(fa, fb), T)
     else:
         # one subnormal float more than R.down/up give: a halving below 2**-1021 rounds
         lo = R.down(np.fmin(fa, fb), ulps) - _TINY
         hi = R.up(np.fmax(fa, fb), ulps) + _TINY
-    hi = where_set(has_max, 1.0, np.minimum(hi, filled_like(1.0, hi)), owned=True)
-    lo = where_set(has_min, -1.0, np.maximum(lo, filled_like(-1.0, lo)), owned=True)
-    # sin(inf) is NaN: an infinite endpoint made the slack infinite, so both are held.
+    # hi: 1 where a maximum is held (flag >= 1, or NaN: fmin ignores it), else
+    # min(hi, 1), which is >= -1 >= flag; lo likewise with the negated flag.
+    # (An infinite end makes the flags NaN and the end values NaN, which
+    # R.down/up have turned into the largest floats: the result is [-1, 1].)
+    one = filled_like(1.0, top)
+    hi = np.fmax(np.minimum(hi, one), np.fmin(top, one))
+    bottom = np.negative(bottom)
+    minus_one = filled_like(-1.0, bottom)
+    lo = np.fmin(np.maximum(lo, minus_one), np.fmax(bottom, minus_one))
     return lo, hi
 
 

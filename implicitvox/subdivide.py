@@ -142,38 +142,51 @@ def _child_boxes(grid: Grid, level: int, parents: tuple[np.ndarray, ...], single
     ``z (2, 1, 1, m)``; the (2, 2, 2, m) result reshapes to ``(8, m)`` in
     child order ``x + 2y + 4z``. Children past the grid get degenerate boxes
     on its edge (they are dropped after). ``single``: float32 bounds rounded
-    outward, looked up in :func:`_edges32` (the same values
-    :func:`implicitvox.precision.outward_float32` gives the float64 ones)."""
-    scale = 1 << (grid.depth - level - 1)
+    outward (the same values :func:`implicitvox.precision.outward_float32`
+    gives the float64 ones). Looked up in :func:`_child_edges` (one gather
+    per axis and end) up to grids of ``_EDGE_TABLE_LIMIT`` voxels a side."""
     lo, hi = [], []
     for a in range(3):
-        first = (parents[a][None, :].astype(np.int64) * 2 + _HALVES) * scale
-        last = first + scale
-        if grid.shape[a] < 1 << grid.depth:   # children may lie past the grid
-            last = np.minimum(last, grid.shape[a])
-            first = np.minimum(first, grid.shape[a])
-        if single and grid.shape[a] < _EDGE_TABLE_LIMIT:
-            down, up = _edges32(grid, a)
-            lo.append(down[first].reshape(_BROADCAST[a]))
-            hi.append(up[last].reshape(_BROADCAST[a]))
+        if grid.shape[a] < _EDGE_TABLE_LIMIT:
+            low, high = _child_edges(grid, level, a, single)
+            lo.append(np.take(low, parents[a], axis=1).reshape(_BROADCAST[a]))
+            hi.append(np.take(high, parents[a], axis=1).reshape(_BROADCAST[a]))
         else:
-            lo.append(grid.edge(a, first).reshape(_BROADCAST[a]))
-            hi.append(grid.edge(a, last).reshape(_BROADCAST[a]))
+            first, last = _child_edge_indices(grid, level, a, parents[a])
+            low, high = grid.edge(a, first), grid.edge(a, last)
+            if single:
+                low, high = outward_float32(low, high)
+            lo.append(low.reshape(_BROADCAST[a]))
+            hi.append(high.reshape(_BROADCAST[a]))
     return tuple(lo), tuple(hi)
 
 
 _HALVES = np.array([[0], [1]], dtype=np.int64)
-#: voxels per axis up to which the float32 edges are tabulated (256 KiB per table)
+#: voxels per axis up to which the child edges are tabulated (tables of at most
+#: 2 * 2**15 values per level and axis)
 _EDGE_TABLE_LIMIT = 1 << 16
 
 
-@functools.lru_cache(maxsize=16)
-def _edges32(grid: Grid, axis: int) -> tuple[np.ndarray, np.ndarray]:
-    """The voxel edges of ``grid`` along ``axis`` (:meth:`Grid.edge`) rounded
-    down and up to float32: one gather per box end instead of the float64
-    arithmetic and its outward rounding."""
-    edges = grid.edge(axis, np.arange(grid.shape[axis] + 1))
-    return outward_float32(edges, edges)
+def _child_edge_indices(grid: Grid, level: int, axis: int, parents: np.ndarray):
+    """Voxel indices of the lower and upper edges (2, m) along ``axis`` of the
+    two halves of octants at ``level`` with coordinates ``parents``, clamped
+    to the grid."""
+    scale = 1 << (grid.depth - level - 1)
+    first = (np.asarray(parents, dtype=np.int64)[None, :] * 2 + _HALVES) * scale
+    return np.minimum(first, grid.shape[axis]), np.minimum(first + scale, grid.shape[axis])
+
+
+@functools.lru_cache(maxsize=256)
+def _child_edges(grid: Grid, level: int, axis: int, single: bool
+                 ) -> tuple[np.ndarray, np.ndarray]:
+    """The lower and upper edges along ``axis`` of the two halves of every
+    octant at ``level`` (arrays (2, 2**level), by octant coordinate), in
+    float64 or rounded outward to float32 (``single``)."""
+    first, last = _child_edge_indices(grid, level, axis, np.arange(1 << level))
+    low, high = grid.edge(axis, first), grid.edge(axis, last)
+    if single:
+        low, high = outward_float32(low, high)
+    return low, high
 
 
 def _child_states(func: Function, grid: Grid, level: int, parents: np.ndarray, dtype):
