@@ -19,8 +19,8 @@ CHUNK = 1 << 16
 
 
 def evaluate_intervals(tape: Tape, lo: tuple[np.ndarray, np.ndarray, np.ndarray],
-                       hi: tuple[np.ndarray, np.ndarray, np.ndarray], dtype=np.float64
-                       ) -> tuple[np.ndarray, np.ndarray]:
+                       hi: tuple[np.ndarray, np.ndarray, np.ndarray], dtype=np.float64,
+                       native: bool = False) -> tuple[np.ndarray, np.ndarray]:
     """Enclosures ``(flo, fhi)`` of the taped function over boxes.
 
     Parameters
@@ -39,7 +39,10 @@ def evaluate_intervals(tape: Tape, lo: tuple[np.ndarray, np.ndarray, np.ndarray]
         What the kernels compute in. float32 (only for tapes that
         :func:`implicitvox.precision.interval_dtype` allows) rounds the boxes
         outward to float32 first (bounds already in float32 are taken as they
-        are); the enclosures are returned as float64.
+        are); the enclosures are returned as float64, unless ``native``.
+    native : bool, default: False
+        Return the enclosures in ``dtype`` (float32 ends are exact in
+        float64, so only the conversion is saved).
 
     Returns
     -------
@@ -54,14 +57,16 @@ def evaluate_intervals(tape: Tape, lo: tuple[np.ndarray, np.ndarray, np.ndarray]
     if single:   # float32 bounds are exact as they are
         lo, hi = zip(*((a, b) if _is_float32(a) and _is_float32(b) else outward_float32(a, b)
                        for a, b in zip(lo, hi)))
+    result = np.float32 if single and native else np.float64
     if columns > step:   # in passes of `step` columns, written into the result
-        flo, fhi = np.empty(shape), np.empty(shape)
+        flo, fhi = np.empty(shape, dtype=result), np.empty(shape, dtype=result)
         for s in range(0, columns, step):
             part = np.s_[..., s:s + step]
             _evaluate(tape, tuple(c[part] for c in lo), tuple(c[part] for c in hi), single,
                       out=(flo[part], fhi[part]))
         return flo, fhi
-    return _evaluate(tape, lo, hi, single)
+    return _evaluate(tape, lo, hi, single, out=(np.empty(shape, dtype=result),
+                                                np.empty(shape, dtype=result)))
 
 
 def _is_float32(a) -> bool:
@@ -109,8 +114,12 @@ def _evaluate(tape, lo, hi, single=False, out=None):
                 result, lane_empty = result[:2], result[2]
                 empty = lane_empty if empty is None else (empty | lane_empty)
             rlo[ins.out], rhi[ins.out] = result
-    np.copyto(flo, rlo[tape.output])   # broadcast and cast to float64
-    np.copyto(fhi, rhi[tape.output])
+    out_lo, out_hi = rlo[tape.output], rhi[tape.output]
+    if flo.dtype == np.float32 and not (_is_float32(out_lo) and _is_float32(out_hi)):
+        out_lo, out_hi = outward_float32(np.asarray(out_lo, dtype=np.float64),
+                                         np.asarray(out_hi, dtype=np.float64))
+    np.copyto(flo, out_lo)   # broadcast (and cast to float64 unless native)
+    np.copyto(fhi, out_hi)
     if empty is not None:
         empty = np.broadcast_to(empty, shape)
         flo[empty] = np.inf

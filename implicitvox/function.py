@@ -141,10 +141,12 @@ class Function:
         return self.interval_columns(tuple(lo_arr.T), tuple(hi_arr.T))
 
     def interval_columns(self, lo: tuple[np.ndarray, ...], hi: tuple[np.ndarray, ...],
-                         dtype=np.float64) -> tuple[np.ndarray, np.ndarray]:
+                         dtype=np.float64, native: bool = False
+                         ) -> tuple[np.ndarray, np.ndarray]:
         """:meth:`interval` on per-axis columns, unchecked (the subdivision's fast path);
-        ``dtype`` float32 only where :func:`implicitvox.precision.interval_dtype` allows."""
-        return evaluate_intervals(self.tape, lo, hi, dtype)
+        ``dtype`` float32 only where :func:`implicitvox.precision.interval_dtype` allows;
+        ``native``: results in ``dtype`` (see :func:`evaluate_intervals`)."""
+        return evaluate_intervals(self.tape, lo, hi, dtype, native)
 
 
 def _box_array(a: Any, name: str) -> np.ndarray:

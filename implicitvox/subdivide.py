@@ -195,7 +195,7 @@ def _child_states(func: Function, grid: Grid, level: int, parents: np.ndarray, d
     the number of children inside the grid."""
     axes = _axes(parents)
     lo, hi = _child_boxes(grid, level, axes, single=np.dtype(dtype) == np.float32)
-    flo, fhi = func.interval_columns(lo, hi, dtype)
+    flo, fhi = func.interval_columns(lo, hi, dtype, native=True)
     flo, fhi = flo.reshape(-1), fhi.reshape(-1)     # child-major: index = child * m + parent
     state = _states(flo, fhi)
     classified = state.size
@@ -228,8 +228,8 @@ def classify_children(func: Function, grid: Grid, level: int, parents: np.ndarra
         if amb.size:
             # the natural bounds are known: only the boxes are rebuilt, as columns
             box_lo, box_hi = grid.octant_boxes(level + 1, _unpack(kids[amb]))
-            state[amb] = _tighten(func, box_lo, box_hi, flo[amb], fhi[amb], state[amb],
-                                  exact, mean_value)
+            state[amb] = _tighten(func, box_lo, box_hi, flo[amb].astype(np.float64),
+                                  fhi[amb].astype(np.float64), state[amb], exact, mean_value)
     ambiguous = state == AMBIGUOUS
     suspects = _NONE
     if recheck > 0.0 and exact is None and level + 1 == grid.depth:
@@ -275,14 +275,14 @@ def suspect_voxels(flo: np.ndarray, fhi: np.ndarray, m: int, recheck: float,
     >>> suspect_voxels(mid - 0.5, mid + 0.5, 1, 0.25)
     array([False, False, False, False,  True,  True,  True,  True])
     """
-    with np.errstate(invalid="ignore"):
-        twice_mid = (flo + fhi).reshape(8, m)
+    with np.errstate(invalid="ignore"):   # in float64 also for float32 bounds (exactly)
+        twice_mid = np.add(flo, fhi, dtype=np.float64).reshape(8, m)
         if inside is not None:
             twice_mid[~inside.reshape(8, m)] = np.nan
         spread = np.fmax.reduce(twice_mid, axis=0)          # fmax, fmin: NaN ignored
         spread -= np.fmin.reduce(twice_mid, axis=0)
         spread *= 0.5
-        margin = fhi - flo
+        margin = np.subtract(fhi, flo, dtype=np.float64)
         margin.reshape(8, m)[...] -= spread
         margin *= recheck
         return np.minimum(-flo, fhi) <= margin

@@ -137,3 +137,20 @@ def test_where_set_is_np_where(shape, mask_shape):
         where_set(mask, 1.0, a)
         assert _same_bits(a, original)                   # a copy unless owned
         assert where_set(mask, 1.0, a, owned=True) is a  # in place when owned
+
+
+@pytest.mark.parametrize("source", ["sin(9*atan2(z, x)) * sin(18*elevation(x, z, y)) - radius(x, z, y)",
+                                    "x", "0.1 + 0*x", "hypot(x, y) - 0.3"])
+def test_native_float32_results_are_the_float64_ones(source):
+    """``native=True`` only skips the conversion: the same ends, as float32."""
+    import implicitvox as ivx
+    from implicitvox.eval_interval import evaluate_intervals
+    tape = ivx.compile(eval(source, {n: getattr(ivx, n) for n in ivx.__all__})).tape
+    rng = np.random.default_rng(5)
+    lo = tuple(rng.uniform(-1.0, 1.0, 5000).astype(np.float32) for _ in range(3))
+    hi = tuple(a + np.float32(0.01) for a in lo)
+    wide = evaluate_intervals(tape, lo, hi, np.float32)
+    native = evaluate_intervals(tape, lo, hi, np.float32, native=True)
+    for w, n in zip(wide, native):
+        assert w.dtype == np.float64 and n.dtype == np.float32
+        assert _same_bits(n.astype(np.float64), w)
