@@ -553,13 +553,16 @@ def _unwrapped_angle(vlo, vhi, ulo, uhi):
     lo, hi = i_atan2(vlo, vhi, ulo, uhi)
     cut = (uhi < 0.0) & (vlo <= 0.0) & (vhi >= 0.0)
     if np.any(cut):   # few boxes: computed on those alone
-        where = np.nonzero(cut)
+        flat = np.flatnonzero(cut)   # (np.nonzero is slow on many axes)
+        where = np.unravel_index(flat, cut.shape)
         v_lo, v_hi, u_hi = (np.broadcast_to(a, cut.shape)[where] for a in (vlo, vhi, uhi))
-        lo, hi = np.array(lo), np.array(hi)
-        lo[where] = R.down(np.arctan2(v_hi, u_hi), T)
+        lo = np.array(np.broadcast_to(lo, cut.shape), order="C")
+        hi = np.array(np.broadcast_to(hi, cut.shape), order="C")
+        lo.reshape(-1)[flat] = R.down(np.arctan2(v_hi, u_hi), T)
         # v = +0 is on the upper side (atan2 gives +pi there): as -0 it gives -pi,
         # and the unwrapped end pi, not 3 pi
-        hi[where] = R.up(R.up(np.arctan2(np.copysign(v_lo, -1.0), u_hi), T) + TWO_PI_UP)
+        hi.reshape(-1)[flat] = R.up(R.up(np.arctan2(np.copysign(v_lo, -1.0), u_hi), T)
+                                    + TWO_PI_UP)
     return lo, hi
 
 
