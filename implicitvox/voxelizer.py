@@ -130,7 +130,7 @@ def voxelize(shape: Any, bounds: Any = None, resolution: Union[int, tuple[int, i
         enclosure reaches 0 only by the amount it overestimates ``f``, as
         estimated from the voxel's siblings
         (:func:`implicitvox.subdivide.suspect_voxels`). 0.25 rechecks the
-        voxels predicted to be settled (about 10% of them, adding 20% to 40%
+        voxels predicted to be settled (about 10% of them, adding about 30%
         to the time); larger values recheck more, up to nearly all at 4; 0
         turns it off. Ignored for shapes with an exact voxel test.
 
