@@ -21,7 +21,7 @@ from implicitvox.eval_interval import apply_op
 from implicitvox.filled import filled_like
 from implicitvox.interval import where_set
 from implicitvox.opcodes import OPCODES
-from implicitvox.precision import FLOAT32_OPS, exact_in_float32
+from implicitvox.precision import FLOAT32_OPS, _params_fit
 from tests.strategies import param_for
 
 BATCH = 3 * filled.MIN_SIZE
@@ -68,13 +68,8 @@ def _same_bits(a: np.ndarray, b: np.ndarray) -> bool:
 
 
 def _float32_ok(name: str, param) -> bool:
-    if name not in FLOAT32_OPS:
-        return False
-    if name == "periodic_angle":
-        return exact_in_float32(param[1]) and exact_in_float32(param[2])
-    if name == "distance":
-        return all(exact_in_float32(c) for c in param)
-    return True
+    """Would a tape with this instruction run in float32 (as the subdivision does)?"""
+    return name in FLOAT32_OPS and _params_fit(name, param)
 
 
 @pytest.mark.parametrize("name", sorted(OPCODES))
@@ -139,8 +134,9 @@ def test_where_set_is_np_where(shape, mask_shape):
         assert where_set(mask, 1.0, a, owned=True) is a  # in place when owned
 
 
-@pytest.mark.parametrize("source", ["sin(9*atan2(z, x)) * sin(18*elevation(x, z, y)) - radius(x, z, y)",
-                                    "x", "0.1 + 0*x", "hypot(x, y) - 0.3"])
+@pytest.mark.parametrize("source", [
+    "sin(9*atan2(z, x)) * sin(18*elevation(x, z, y)) - radius(x, z, y)",
+    "x", "0.1 + 0*x", "hypot(x, y) - 0.3"])
 def test_native_float32_results_are_the_float64_ones(source):
     """``native=True`` only skips the conversion: the same ends, as float32."""
     import implicitvox as ivx
