@@ -58,15 +58,15 @@ def evaluate_intervals(tape: Tape, lo: tuple[np.ndarray, np.ndarray, np.ndarray]
         lo, hi = zip(*((a, b) if _is_float32(a) and _is_float32(b) else outward_float32(a, b)
                        for a, b in zip(lo, hi)))
     result = np.float32 if single and native else np.float64
-    if columns > step:   # in passes of `step` columns, written into the result
-        flo, fhi = np.empty(shape, dtype=result), np.empty(shape, dtype=result)
-        for s in range(0, columns, step):
-            part = np.s_[..., s:s + step]
-            _evaluate(tape, tuple(c[part] for c in lo), tuple(c[part] for c in hi), single,
-                      out=(flo[part], fhi[part]))
+    flo, fhi = np.empty(shape, dtype=result), np.empty(shape, dtype=result)
+    if columns <= step:
+        _evaluate(tape, lo, hi, single, flo, fhi)
         return flo, fhi
-    return _evaluate(tape, lo, hi, single, out=(np.empty(shape, dtype=result),
-                                                np.empty(shape, dtype=result)))
+    for s in range(0, columns, step):   # in passes of `step` columns
+        part = np.s_[..., s:s + step]
+        _evaluate(tape, tuple(c[part] for c in lo), tuple(c[part] for c in hi), single,
+                  flo[part], fhi[part])
+    return flo, fhi
 
 
 def _is_float32(a) -> bool:
@@ -87,13 +87,12 @@ def apply_op(op, param, lo: tuple, hi: tuple, single: bool = False):
     return op.interval(lo, hi, param)
 
 
-def _evaluate(tape, lo, hi, single=False, out=None):
-    """The enclosures over one pass of boxes, as new float64 arrays or into ``out``."""
-    shape = np.broadcast_shapes(*(a.shape for a in lo), *(a.shape for a in hi))
-    flo, fhi = (np.empty(shape), np.empty(shape)) if out is None else out
+def _evaluate(tape, lo, hi, single: bool, flo: np.ndarray, fhi: np.ndarray) -> None:
+    """The enclosures over one pass of boxes, written into ``flo, fhi``."""
+    shape = flo.shape
     if tape.undefined:
         flo[...], fhi[...] = np.inf, -np.inf
-        return flo, fhi
+        return
     rlo: list = [None] * tape.n_registers
     rhi: list = [None] * tape.n_registers
     for axis, name in enumerate("xyz"):
@@ -124,4 +123,3 @@ def _evaluate(tape, lo, hi, single=False, out=None):
         empty = np.broadcast_to(empty, shape)
         flo[empty] = np.inf
         fhi[empty] = -np.inf
-    return flo, fhi
