@@ -37,11 +37,11 @@ from typing import Any, Callable, Optional
 import numpy as np
 
 import implicitvox as iv
-from implicitvox.shape import AMBIGUOUS, EMPTY, FULL
-from implicitvox.tribox import Triangles
-from implicitvox.crossings import RayWinding
-from implicitvox.mesh_subdivide import _sorted_unique
-from implicitvox.ranges import buckets, expand_boxes, gather
+from implicitvox.expr.shape import AMBIGUOUS, EMPTY, FULL
+from implicitvox.mesh.tribox import Triangles
+from implicitvox.mesh.crossings import RayWinding
+from implicitvox.mesh.pairs import _sorted_unique
+from implicitvox.mesh.ranges import buckets, expand_boxes, gather
 
 __all__ = ["exact_classifier", "MeshClassifier", "SETTLE_DEPTH"]
 

@@ -289,7 +289,7 @@ class Polyhedron(Solid):
     """
 
     def __init__(self, vertices: Any, faces: Any = None):
-        from implicitvox.mesh_input import as_triangles
+        from implicitvox.mesh.inputs import as_triangles
         mesh = vertices if faces is None else (vertices, faces)
         v, f = as_triangles(mesh)
         if not len(f):

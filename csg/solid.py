@@ -381,7 +381,7 @@ class ExprSolid(Solid):
     def __init__(self, expr: Any, bounds: Bounds = None):
         self._expr = iv.wrap(expr)
         if bounds is not None:
-            from implicitvox.grid import parse_bounds
+            from implicitvox.octree.grid import parse_bounds
             bounds = parse_bounds(bounds)
         self._bounds = bounds
 

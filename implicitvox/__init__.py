@@ -12,26 +12,26 @@ Examples
 >>> float(f(0.0, 0.0, 2.0))
 1.0
 """
-from .expr import Expr, constant, wrap, x, y, z
-from .coords import (Cylindrical, Spherical, cylindrical, elevation, phi, r, radius, rho,
-                     spherical, theta)
-from .function import Function, compile
-from .grid import Grid
-from .io import load
-from .octree import Octree, PointerOctree
-from .shape import AMBIGUOUS, EMPTY, FULL, Shape
-from .sweep import repeat, repeat_polar
-from .voxelizer import voxelize
-from .mesh_voxelizer import voxelize_mesh
-from .winding import winding_numbers
-from .bezier import BezierPatch, utah_teapot, voxelize_bezier
+from ._version import __version__
+from .expr.nodes import Expr, constant, wrap, x, y, z
+from .expr.coords import (Cylindrical, Spherical, cylindrical, elevation, phi, r, radius, rho,
+                          spherical, theta)
+from .expr.functions import (abs, acos, asin, atan, atan2, clip, cos, exp, floor, hypot, log,
+                             max, min, sin, sqrt, square, tan)
+from .expr.shape import AMBIGUOUS, EMPTY, FULL, Shape
+from .expr.sweeps import repeat, repeat_polar
+from .eval.function import Function, compile
+from .octree.grid import Grid
+from .octree.store import Octree, PointerOctree
+from .octree.voxels import Voxels
+from .mesh.bezier import BezierPatch, utah_teapot
+from .mesh.winding import winding_numbers
 from . import linf
 from .linf import linf_distance
-from .voxels import Voxels
-from .functions import (abs, acos, asin, atan, atan2, clip, cos, exp, floor, hypot, log,
-                        max, min, sin, sqrt, square, tan)
-
-__version__ = "0.1.0"
+from .voxelizers.implicit import voxelize
+from .voxelizers.mesh import voxelize_mesh
+from .voxelizers.bezier import voxelize_bezier
+from .io.files import load
 
 __all__ = [
     "Expr", "constant", "wrap", "x", "y", "z",

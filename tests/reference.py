@@ -4,9 +4,9 @@ from __future__ import annotations
 import mpmath
 from mpmath import iv
 
-from implicitvox.expr import Expr
+from implicitvox.expr.nodes import Expr
 
-from implicitvox.reference import EXP_LIMIT, PERIODIC_LIMIT, mp_evaluate
+from implicitvox.eval.reference import EXP_LIMIT, PERIODIC_LIMIT, mp_evaluate
 
 DPS = 60
 

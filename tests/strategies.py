@@ -5,7 +5,7 @@ import numpy as np
 from hypothesis import strategies as st
 
 import implicitvox as ivx
-from implicitvox.expr import Expr
+from implicitvox.expr.nodes import Expr
 
 moderate = st.floats(-50.0, 50.0, allow_nan=False)
 wide = st.floats(-1e6, 1e6, allow_nan=False)
@@ -40,7 +40,7 @@ def param_for(draw, name: str):
     if name in ("addc", "rsubc", "mulc"):
         return draw(anywhere)
     if name in ("repeat", "repeat_polar"):
-        from implicitvox.opcodes import prepared
+        from implicitvox.eval.opcodes import prepared
         return prepared(name, draw(sweep_param(name)))
     if name == "periodic_angle":
         return (draw(st.sampled_from(["sin", "cos"])), float(draw(st.integers(-9, 9))),

@@ -16,12 +16,12 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from implicitvox import filled
-from implicitvox.eval_interval import apply_op
-from implicitvox.filled import filled_like
-from implicitvox.interval import where_set
-from implicitvox.opcodes import OPCODES
-from implicitvox.precision import FLOAT32_OPS, _params_fit
+from implicitvox.interval import filled
+from implicitvox.eval.interval import apply_op
+from implicitvox.interval.filled import filled_like
+from implicitvox.interval.kernels import where_set
+from implicitvox.eval.opcodes import OPCODES
+from implicitvox.eval.precision import FLOAT32_OPS, _params_fit
 from tests.strategies import param_for
 
 BATCH = 3 * filled.MIN_SIZE
@@ -140,7 +140,7 @@ def test_where_set_is_np_where(shape, mask_shape):
 def test_native_float32_results_are_the_float64_ones(source):
     """``native=True`` only skips the conversion: the same ends, as float32."""
     import implicitvox as ivx
-    from implicitvox.eval_interval import evaluate_intervals
+    from implicitvox.eval.interval import evaluate_intervals
     tape = ivx.compile(eval(source, {n: getattr(ivx, n) for n in ivx.__all__})).tape
     rng = np.random.default_rng(5)
     lo = tuple(rng.uniform(-1.0, 1.0, 5000).astype(np.float32) for _ in range(3))

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 import implicitvox as ivx
-from implicitvox.cli import main
+from implicitvox.io.cli import main
 
 
 def run(argv, capsys):

@@ -13,7 +13,7 @@ import implicitvox as ivx
 from csg import (Blobby, Box, Circle, ConvexPolyhedron, Cylinder, Ellipsoid, HalfSpace,
                  Polygon, Polyhedron, Rectangle, SceneError, Sphere, Torus, load_json,
                  linear_extrude, rotate_extrude, smooth_union)
-from implicitvox.shape import AMBIGUOUS, EMPTY, FULL
+from implicitvox.expr.shape import AMBIGUOUS, EMPTY, FULL
 from tests.surface import found, surface_brackets
 
 SPHERE_MESH = pv.Sphere(radius=1.0, theta_resolution=24, phi_resolution=24)
@@ -56,8 +56,8 @@ def test_interior_and_surface_bracket_the_volume(name, solid, volume):
     inner = vox.interior_count * cell
     outer = (vox.interior_count + vox.count) * cell
     if volume is None:       # polyhedron minus a cylinder: Monte Carlo with exact winding
-        from implicitvox.crossings import RayWinding
-        from implicitvox.mesh_input import as_triangles
+        from implicitvox.mesh.crossings import RayWinding
+        from implicitvox.mesh.inputs import as_triangles
         v, f = as_triangles(SPHERE_MESH.scale((1, 1, 2), inplace=False))
         rng = np.random.default_rng(0)
         (lo, hi), n = solid.bounds, 400_000

@@ -15,7 +15,7 @@ from hypothesis import HealthCheck, assume, given, settings
 from hypothesis import strategies as st
 
 import implicitvox as ivx
-from implicitvox.opcodes import OPCODES
+from implicitvox.eval.opcodes import OPCODES
 from tests.reference import DPS, contains, iv_interval, mp_value
 from tests.strategies import (BINARY, box3, elements_for, expression, interval, param_for,
                               samples)

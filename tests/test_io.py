@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 import implicitvox as ivx
-from implicitvox.examples import sinsin
+from implicitvox.expr.examples import sinsin
 
 
 @pytest.fixture(scope="module")

@@ -9,8 +9,8 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 import implicitvox as ivx
-from implicitvox.mean_value import evaluate_interval_gradients, mean_value_enclosure
-from implicitvox.opcodes import OPCODES
+from implicitvox.eval.mean_value import evaluate_interval_gradients, mean_value_enclosure
+from implicitvox.eval.opcodes import OPCODES
 from tests.reference import contains, mp_value
 from tests.strategies import expression
 

@@ -12,8 +12,8 @@ import pytest
 
 import implicitvox as ivx
 from implicitvox import hypot, max, min, sqrt, x, y, z
-from implicitvox.examples import blobby, gear, lobed_plate, replicated_torus, sinsin
-from implicitvox.grid import Grid
+from implicitvox.expr.examples import blobby, gear, lobed_plate, replicated_torus, sinsin
+from implicitvox.octree.grid import Grid
 from tests.surface import corner_sign_voxels, found, surface_brackets
 
 RES = 64

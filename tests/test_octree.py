@@ -5,8 +5,8 @@ import numpy as np
 import pytest
 
 import implicitvox as ivx
-from implicitvox import morton
-from implicitvox.examples import sinsin
+from implicitvox.octree import morton
+from implicitvox.expr.examples import sinsin
 
 
 def same_tree(a: ivx.Octree, b: ivx.Octree) -> bool:

@@ -17,17 +17,18 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 import implicitvox as ivx
-from implicitvox import interval as iv
-from implicitvox import rounding
-from implicitvox import subdivide as subdivision
-from implicitvox.eval_interval import apply_op
-from implicitvox.coords import cylindrical
-from implicitvox.examples import gear, sinsin
-from implicitvox.grid import Grid
-from implicitvox.opcodes import OPCODES
-from implicitvox.shape import ExprShape
-from implicitvox.precision import (FLOAT32_OPS, float32_bounds, interval_dtype, level_dtype,
-                                   outward_float32, supports_float32)
+from implicitvox.interval import kernels as iv
+from implicitvox.interval import rounding
+from implicitvox.octree import subdivide as subdivision
+from implicitvox.eval.interval import apply_op
+from implicitvox.expr.coords import cylindrical
+from implicitvox.expr.examples import gear, sinsin
+from implicitvox.octree.grid import Grid
+from implicitvox.eval.opcodes import OPCODES
+from implicitvox.expr.shape import ExprShape
+from implicitvox.eval.precision import FLOAT32_OPS, supports_float32
+from implicitvox.interval.float32 import float32_bounds, outward_float32
+from implicitvox.octree.precision import interval_dtype, level_dtype
 from tests.reference import DPS, contains
 from tests.surface import found, surface_brackets
 from tests.strategies import elements_for, interval, param_for, samples

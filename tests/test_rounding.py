@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 import implicitvox as ivx
-from implicitvox import rounding
+from implicitvox.interval import rounding
 from tests.reference import contains, mp_value
 
 X = ivx.x
@@ -100,7 +100,7 @@ def test_sine_and_cosine_from_tan_are_enclosed(name):
     """The interval kernels compute sin and cos from numpy's tan; on degenerate
     intervals their widened values hold the exact ones (mpmath, 60 digits), and
     the computed values stay within the stated floats of them."""
-    from implicitvox import interval as iv
+    from implicitvox.interval import kernels as iv
     values = iv.sin_values if name == "sin" else iv.cos_values
     kernel = iv.i_sin if name == "sin" else iv.i_cos
     bound = rounding.SIN_ULPS if name == "sin" else rounding.COS_ULPS

@@ -6,7 +6,7 @@ import numpy as np
 
 import implicitvox as ivx
 from implicitvox import x, y, z
-from implicitvox.tape import build_tape
+from implicitvox.eval.tape import build_tape
 from tests.reference import contains
 
 

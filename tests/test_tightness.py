@@ -7,8 +7,8 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from implicitvox import rounding
-from implicitvox.opcodes import OPCODES
+from implicitvox.interval import rounding
+from implicitvox.eval.opcodes import OPCODES
 from tests.strategies import interval
 
 # name -> (increasing?, argument strategy)

@@ -4,7 +4,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from implicitvox.tribox import Triangles
+from implicitvox.mesh.tribox import Triangles
 from tests.clip_oracle import triangle_meets_box
 
 

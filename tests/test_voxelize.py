@@ -8,7 +8,7 @@ import pytest
 
 import implicitvox as ivx
 from implicitvox import sqrt, x, y, z
-from implicitvox.examples import gear, sinsin
+from implicitvox.expr.examples import gear, sinsin
 
 BALL = sqrt(x * x + y * y + z * z) - 0.7
 CUBE = ((-1.0,) * 3, (1.0,) * 3)

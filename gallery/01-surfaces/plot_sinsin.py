@@ -13,7 +13,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 from common import RESOLUTION, out  # noqa: E402
 
 import implicitvox as iv  # noqa: E402
-from implicitvox.examples import sinsin  # noqa: E402
+from implicitvox.expr.examples import sinsin
 
 # %%
 # Two of the four surfaces of Fig. 6.

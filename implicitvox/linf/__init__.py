@@ -35,7 +35,7 @@ from typing import Any
 
 import numpy as np
 
-from .classify import classify_by_distance
+from .classify import Primitive, classify_by_distance
 from .mesh import TriangleMesh
 from .polytope import ConvexPolytope, HalfSpace, triangle_distance
 from .sphere import Sphere
@@ -46,7 +46,7 @@ from .quadric import Quadric
 
 __all__ = ["linf_distance", "HalfSpace", "ConvexPolytope", "Sphere", "Ellipsoid", "Cylinder", "Frustum",
            "Torus", "Quadric", "TriangleMesh",
-           "triangle_distance", "classify_by_distance"]
+           "triangle_distance", "classify_by_distance", "Primitive"]
 
 
 def linf_distance(shape: Any, points: Any, weights: Any = None) -> np.ndarray:
@@ -56,8 +56,7 @@ def linf_distance(shape: Any, points: Any, weights: Any = None) -> np.ndarray:
     ``linf_distance(points, weights)`` method (as :mod:`csg` solids with
     exact leaves have).
     """
-    if isinstance(shape, (HalfSpace, ConvexPolytope, Sphere, Ellipsoid, Frustum, Torus,
-                          Quadric, TriangleMesh)):
+    if isinstance(shape, Primitive):
         return shape.distance(points, weights)
     method = getattr(shape, "linf_distance", None)
     if callable(method):

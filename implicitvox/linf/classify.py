@@ -8,13 +8,13 @@ single boundary point has ``D = 1`` exactly and counts as meeting it.
 """
 from __future__ import annotations
 
-from typing import Callable
+from typing import Any, Callable, Optional
 
 import numpy as np
 
-from ..shape import AMBIGUOUS, EMPTY, FULL
+from ..expr.shape import AMBIGUOUS, EMPTY, FULL
 
-__all__ = ["classify_by_distance"]
+__all__ = ["classify_by_distance", "Primitive"]
 
 
 def classify_by_distance(distance: Callable, lo: np.ndarray, hi: np.ndarray,
@@ -32,3 +32,19 @@ def classify_by_distance(distance: Callable, lo: np.ndarray, hi: np.ndarray,
     if signed:
         out[d < -1] = FULL
     return out
+
+
+class Primitive:
+    """Base of the max-norm primitives: a subclass gives ``distance(points,
+    weights)`` (signed, weighted per axis) and ``expr``; the exact box test
+    (§5.1) comes from the distance here, once for all of them."""
+
+    #: is the distance signed (a closed solid)? An open mesh's is not.
+    signed: bool = True
+
+    def distance(self, points: Any, weights: Optional[Any] = None) -> np.ndarray:
+        raise NotImplementedError
+
+    def classify_boxes(self, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+        """EMPTY / FULL / AMBIGUOUS of boxes ``[lo, hi]`` (``(n, 3)`` each), exactly."""
+        return classify_by_distance(self.distance, lo, hi, signed=self.signed)

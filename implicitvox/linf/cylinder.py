@@ -37,9 +37,10 @@ from typing import Any
 
 import numpy as np
 
-import implicitvox as iv
+from .. import expr as ex
 
 from .ellipsoid import _roots
+from .classify import Primitive
 from .norm import as_points, as_weights
 
 __all__ = ["Cylinder", "Frustum"]
@@ -49,7 +50,7 @@ _SIGNS = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-
 _TOL = 1e-12
 
 
-class Frustum:
+class Frustum(Primitive):
     """Capped cone or frustum: base centre, axis direction (any length), height, radius
     ``r1`` at the base and ``r2`` at the top (one of them may be 0: a cone)."""
 
@@ -81,13 +82,13 @@ class Frustum:
         return self.r1 + self.k * s
 
     @property
-    def expr(self) -> iv.Expr:
-        y = [iv.x - self.c[0], iv.y - self.c[1], iv.z - self.c[2]]
+    def expr(self) -> ex.Expr:
+        y = [ex.x - self.c[0], ex.y - self.c[1], ex.z - self.c[2]]
         s = self.a[0] * y[0] + self.a[1] * y[1] + self.a[2] * y[2]
         perp = [y[i] - self.a[i] * s for i in range(3)]
-        rho = iv.sqrt(perp[0] ** 2 + perp[1] ** 2 + perp[2] ** 2)
+        rho = ex.sqrt(perp[0] ** 2 + perp[1] ** 2 + perp[2] ** 2)
         side = (rho - (self.r1 + self.k * s)) / float(np.hypot(1.0, self.k))
-        return iv.max(side, -s, s - self.h)
+        return ex.max(side, -s, s - self.h)
 
     @property
     def bounds(self):
@@ -315,9 +316,6 @@ class Frustum:
         ok = (t >= 0) & (np.sqrt(np.sum(gap * gap, axis=1)) <= r * (1 + _TOL))
         return np.where(ok, t, np.inf)
 
-    def classify_boxes(self, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
-        from .classify import classify_by_distance
-        return classify_by_distance(self.distance, lo, hi)
 
 
 class Cylinder(Frustum):

@@ -29,8 +29,9 @@ from typing import Any, Optional
 
 import numpy as np
 
-import implicitvox as iv
+from .. import expr as ex
 
+from .classify import Primitive
 from .norm import as_points, as_weights
 
 __all__ = ["Ellipsoid"]
@@ -50,7 +51,7 @@ def _roots(A, B, C):
     return np.minimum(r1, r2), np.maximum(r1, r2)
 
 
-class Ellipsoid:
+class Ellipsoid(Primitive):
     """Ellipsoid with ``center``, semi-axes ``radii`` along the columns of ``rotation``
     (an orthonormal 3 x 3 matrix; identity by default)."""
 
@@ -79,12 +80,12 @@ class Ellipsoid:
         return cls(center, np.sqrt(vals), vecs)
 
     @property
-    def expr(self) -> iv.Expr:
-        u = [iv.x - self.center[0], iv.y - self.center[1], iv.z - self.center[2]]
+    def expr(self) -> ex.Expr:
+        u = [ex.x - self.center[0], ex.y - self.center[1], ex.z - self.center[2]]
         local = [sum(float(self.rotation[r, a]) * u[r] for r in range(3)) / self.radii[a]
                  for a in range(3)]
         k = float(self.radii.min())
-        return k * (iv.sqrt(local[0] ** 2 + local[1] ** 2 + local[2] ** 2) - 1)
+        return k * (ex.sqrt(local[0] ** 2 + local[1] ** 2 + local[2] ** 2) - 1)
 
     @property
     def bounds(self):
@@ -164,6 +165,3 @@ class Ellipsoid:
                     best = np.fmin(best, np.where(ok, t, np.inf))
         return best
 
-    def classify_boxes(self, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
-        from .classify import classify_by_distance
-        return classify_by_distance(self.distance, lo, hi)

@@ -30,6 +30,10 @@ from typing import Any
 
 import numpy as np
 
+from ..mesh.crossings import RayWinding
+from ..mesh.inputs import as_triangles
+from ..octree import morton
+from .classify import Primitive
 from .norm import as_points, as_weights, in_blocks
 from .polytope import triangle_distance
 
@@ -40,13 +44,12 @@ _BLOCK = 1 << 15      # points per block
 _LEAF = 2             # triangles per leaf of the hierarchy
 
 
-class TriangleMesh:
+class TriangleMesh(Primitive):
     """A triangle mesh ``(vertices, faces)``; signed if closed (each edge shared by
     exactly two faces), else unsigned."""
 
     def __init__(self, vertices: Any, faces: Any):
         from scipy.spatial import cKDTree
-        from implicitvox.mesh_input import as_triangles
         v, f = as_triangles((vertices, faces))
         if not len(f):
             raise ValueError("the mesh has no triangles")
@@ -57,13 +60,13 @@ class TriangleMesh:
         edges = np.sort(np.concatenate([f[:, [0, 1]], f[:, [1, 2]], f[:, [2, 0]]]), axis=1)
         _, counts = np.unique(edges, axis=0, return_counts=True)
         self.closed = bool(np.all(counts == 2))
+        self.signed = self.closed
         self._winding = None
 
     def _build_bvh(self) -> None:
         """A bounding volume hierarchy in arrays: triangles in Morton order of their
         centroids, leaves of ``_LEAF`` consecutive triangles, each level's boxes the
         union of two boxes of the level below (a complete binary tree)."""
-        from implicitvox import morton
         c = self.centroids
         lo, hi = c.min(axis=0), c.max(axis=0)
         q = ((c - lo) / np.where(hi > lo, hi - lo, 1.0) * ((1 << 20) - 1)).astype(np.int64)
@@ -89,7 +92,6 @@ class TriangleMesh:
         w = as_weights(weights, len(p))
         out = in_blocks(self._unsigned, p, w, _BLOCK)
         if self.closed:
-            from implicitvox.crossings import RayWinding
             if self._winding is None:
                 self._winding = RayWinding(self.tri)
             inside = self._winding(p) != 0
@@ -139,6 +141,3 @@ class TriangleMesh:
         return (tuple(self.tri.min(axis=(0, 1)).tolist()),
                 tuple(self.tri.max(axis=(0, 1)).tolist()))
 
-    def classify_boxes(self, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
-        from .classify import classify_by_distance
-        return classify_by_distance(self.distance, lo, hi, signed=self.closed)

@@ -28,6 +28,8 @@ from typing import Any, Optional
 
 import numpy as np
 
+from .. import expr as ex
+from .classify import Primitive
 from .norm import as_points, as_weights, in_blocks
 
 __all__ = ["ConvexPolytope", "HalfSpace", "triangle_distance", "CHUNK"]
@@ -49,7 +51,7 @@ def _unique_directions(u: np.ndarray) -> np.ndarray:
     return u[np.sort(keep)]
 
 
-class ConvexPolytope:
+class ConvexPolytope(Primitive):
     """A bounded convex polytope: ``n_f . x <= d_f`` with its vertices and edges.
 
     Use :meth:`from_points` (convex hull) or :meth:`from_planes`.
@@ -119,21 +121,17 @@ class ConvexPolytope:
     @property
     def expr(self):
         """``max_f (n_f . x - d_f)``: the implicit function (a Shape for the voxelizer)."""
-        import implicitvox as iv
-        terms = [n[0] * iv.x + n[1] * iv.y + n[2] * iv.z - d
+        terms = [n[0] * ex.x + n[1] * ex.y + n[2] * ex.z - d
                  for n, d in zip(self.normals, self.offsets)]
-        return iv.max(*terms)
+        return ex.max(*terms)
 
     @property
     def bounds(self):
         return tuple(self.vertices.min(0).tolist()), tuple(self.vertices.max(0).tolist())
 
-    def classify_boxes(self, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
-        from .classify import classify_by_distance
-        return classify_by_distance(self.distance, lo, hi)
 
 
-class HalfSpace:
+class HalfSpace(Primitive):
     """``n . x <= d``: signed distance ``(n.p - d) / h_w(n)`` (exactly, on both sides)."""
 
     def __init__(self, normal: Any, offset: float):
@@ -144,18 +142,14 @@ class HalfSpace:
 
     @property
     def expr(self):
-        import implicitvox as iv
         n = self.normal
-        return n[0] * iv.x + n[1] * iv.y + n[2] * iv.z - self.offset
+        return n[0] * ex.x + n[1] * ex.y + n[2] * ex.z - self.offset
 
     def distance(self, points: Any, weights: Any = None) -> np.ndarray:
         p = as_points(points)
         w = as_weights(weights, len(p))
         return (p @ self.normal - self.offset) / (w @ np.abs(self.normal))
 
-    def classify_boxes(self, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
-        from .classify import classify_by_distance
-        return classify_by_distance(self.distance, lo, hi)
 
 
 def triangle_distance(points: np.ndarray, tri: np.ndarray,

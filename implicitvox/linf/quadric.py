@@ -38,8 +38,9 @@ from typing import Any
 
 import numpy as np
 
-import implicitvox as iv
+from .. import expr as ex
 
+from .classify import Primitive
 from .norm import as_points, as_weights
 
 __all__ = ["Quadric"]
@@ -68,7 +69,7 @@ def _valid_root(a2, a1, a0, bounds):
     return best
 
 
-class Quadric:
+class Quadric(Primitive):
     """The solid ``x^T A x + b.x + c <= 0`` (``A`` symmetric 3 x 3)."""
 
     def __init__(self, A: Any, b: Any, c: float):
@@ -104,14 +105,14 @@ class Quadric:
         return np.einsum("ni,ij,nj->n", p, self.A, p) + p @ self.b + self.c
 
     @property
-    def expr(self) -> iv.Expr:
-        v = (iv.x, iv.y, iv.z)
-        total = iv.constant(self.c)
+    def expr(self) -> ex.Expr:
+        v = (ex.x, ex.y, ex.z)
+        total = ex.constant(self.c)
         for i in range(3):
             if self.b[i]:
                 total = total + float(self.b[i]) * v[i]
             if self.A[i, i]:
-                total = total + float(self.A[i, i]) * iv.square(v[i])
+                total = total + float(self.A[i, i]) * ex.square(v[i])
             for j in range(i + 1, 3):
                 if self.A[i, j]:
                     total = total + float(2 * self.A[i, j]) * v[i] * v[j]
@@ -173,6 +174,3 @@ class Quadric:
                 best = np.fmin(best, _valid_root(a2, a1, a0, bounds))
         return np.where(q0 < 0, -best, best)
 
-    def classify_boxes(self, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
-        from .classify import classify_by_distance
-        return classify_by_distance(self.distance, lo, hi)

@@ -19,8 +19,9 @@ from typing import Any
 
 import numpy as np
 
-import implicitvox as iv
+from .. import expr as ex
 
+from .classify import Primitive
 from .norm import as_points, as_weights
 
 __all__ = ["Sphere"]
@@ -34,7 +35,7 @@ def _smaller_root(A, B, C):
         return np.where(B > 0, C / (B + s), (B - s) / A)
 
 
-class Sphere:
+class Sphere(Primitive):
     """Sphere with ``center`` and radius ``r`` (negative distances inside)."""
 
     def __init__(self, center: Any, r: float):
@@ -44,9 +45,9 @@ class Sphere:
             raise ValueError(f"r must be positive, got {r!r}")
 
     @property
-    def expr(self) -> iv.Expr:
+    def expr(self) -> ex.Expr:
         cx, cy, cz = self.center
-        return iv.sqrt((iv.x - cx) ** 2 + (iv.y - cy) ** 2 + (iv.z - cz) ** 2) - self.r
+        return ex.sqrt((ex.x - cx) ** 2 + (ex.y - cy) ** 2 + (ex.z - cz) ** 2) - self.r
 
     @property
     def bounds(self):
@@ -89,6 +90,3 @@ class Sphere:
         out[~inside] = np.maximum(best, 0.0)
         return out
 
-    def classify_boxes(self, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
-        from .classify import classify_by_distance
-        return classify_by_distance(self.distance, lo, hi)

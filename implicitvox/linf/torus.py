@@ -40,8 +40,9 @@ from typing import Any
 
 import numpy as np
 
-import implicitvox as iv
+from .. import expr as ex
 
+from .classify import Primitive
 from .norm import as_points, as_weights, in_blocks
 from .torus_frame import TorusFrame
 
@@ -68,7 +69,7 @@ def _aligned_index(a: np.ndarray):
     return k if np.allclose(np.abs(a), np.eye(3)[k], rtol=0, atol=1e-12) else None
 
 
-class Torus:
+class Torus(Primitive):
     """Torus with ``center``, ``axis`` (``'x'``, ``'y'``, ``'z'`` or any non-zero vector),
     major radius ``R`` (centre to tube centre) and minor radius ``r`` (the tube's).
 
@@ -98,14 +99,14 @@ class Torus:
             self.order = [a for a in range(3) if a != self.axis] + [self.axis]
 
     @property
-    def expr(self) -> iv.Expr:
-        q = [iv.x - self.center[0], iv.y - self.center[1], iv.z - self.center[2]]
+    def expr(self) -> ex.Expr:
+        q = [ex.x - self.center[0], ex.y - self.center[1], ex.z - self.center[2]]
         if self.axis is not None:
             u, v, w = (q[a] for a in self.order)
         else:
             u, v, w = (sum(float(e[i]) * q[i] for i in range(3))
                        for e in (self.frame.e1, self.frame.e2, self.frame.a))
-        return iv.hypot(iv.hypot(u, v) - self.R, w) - self.r
+        return ex.hypot(ex.hypot(u, v) - self.R, w) - self.r
 
     @property
     def bounds(self):
@@ -172,6 +173,3 @@ class Torus:
         # t = 0 itself may already hold (a point on the surface)
         return np.where(test(q, w, t_lo), t_lo, hi_bits.view(np.float64))
 
-    def classify_boxes(self, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
-        from .classify import classify_by_distance
-        return classify_by_distance(self.distance, lo, hi)

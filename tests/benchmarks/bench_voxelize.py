@@ -26,9 +26,9 @@ import time
 import numpy as np
 
 import implicitvox as ivx
-from implicitvox.examples import sinsin
-from implicitvox.grid import Grid
-from implicitvox.precision import interval_dtype
+from implicitvox.expr.examples import sinsin
+from implicitvox.octree.grid import Grid
+from implicitvox.octree.precision import interval_dtype
 
 MODELS = [(3, 4), (5, 6), (9, 10), (9, 18)]
 

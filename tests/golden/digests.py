@@ -69,8 +69,8 @@ def _boxes(bounds, n: int = 512, seed: int = 7):
 
 def _examples(out: dict) -> None:
     import implicitvox as iv
-    from implicitvox.examples import EXAMPLES, example
-    from implicitvox.tape import build_tape
+    from implicitvox.expr.examples import EXAMPLES, example
+    from implicitvox.eval.tape import build_tape
     for name in sorted(EXAMPLES):
         shape = example(name)
         bounds = _cube(shape.bounds)
@@ -95,8 +95,8 @@ def _listing(tape) -> str:
 
 
 def _opcodes(out: dict) -> None:
-    from implicitvox.eval_interval import apply_op
-    from implicitvox.opcodes import OPCODES
+    from implicitvox.eval.interval import apply_op
+    from implicitvox.eval.opcodes import OPCODES
     params = {"powi": 3, "powr": 1.5, "addc": 0.3, "rsubc": -1.25, "mulc": 2.5, "divc": 3.0,
               "periodic_angle": ("sin", 3.0, 0.5), "distance": (0.1, -0.2, 0.3)}
     for name in sorted(OPCODES):
@@ -132,7 +132,7 @@ def _openscad(out: dict) -> None:
         stl = path.with_suffix(".stl")
         for res in (64, 128):
             vox = iv.voxelize_mesh(str(stl), bounds=_cube(iv_mesh_bounds(stl), 1.04),
-                                   resolution=res, solid=True)
+                                   resolution=res, interior=True)
             for k, v in _voxel_digests(vox).items():
                 out[f"mesh/{stl.stem}/{res}/{k}"] = v
 

@@ -1,0 +1,41 @@
+"""Point evaluator: one numpy pass per tape instruction over a batch of points."""
+from __future__ import annotations
+
+import numpy as np
+
+from .tape import Tape
+
+__all__ = ["evaluate_points"]
+
+CHUNK = 1 << 16
+
+
+def evaluate_points(tape: Tape, xs: np.ndarray, ys: np.ndarray, zs: np.ndarray) -> np.ndarray:
+    """Values of the taped function at the points ``(xs[i], ys[i], zs[i])``.
+
+    ``xs, ys, zs`` are 1-D float arrays of one length. Outside a function's
+    domain the value is NaN, as numpy computes it.
+    """
+    n = xs.shape[0]
+    if n > CHUNK:
+        return np.concatenate([_evaluate(tape, xs[s:s + CHUNK], ys[s:s + CHUNK], zs[s:s + CHUNK])
+                               for s in range(0, n, CHUNK)])
+    return _evaluate(tape, xs, ys, zs)
+
+
+def _evaluate(tape, xs, ys, zs):
+    n = xs.shape[0]
+    if tape.undefined:
+        return np.full(n, np.nan)
+    regs: list = [None] * tape.n_registers
+    for name, column in (("x", xs), ("y", ys), ("z", zs)):
+        if tape.inputs[name] >= 0:
+            regs[tape.inputs[name]] = column
+    for c in tape.constants:
+        regs[c.register] = np.float64(c.value)
+    with np.errstate(all="ignore"):
+        for ins in tape.instructions:
+            args = tuple(regs[a] for a in ins.args)
+            regs[ins.out] = (ins.param.point(args, evaluate_points) if ins.op.oracle
+                             else ins.op.point(args, ins.param))
+    return np.array(np.broadcast_to(regs[tape.output], (n,)), dtype=np.float64)

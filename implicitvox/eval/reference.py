@@ -1,0 +1,56 @@
+"""Exact evaluation with mpmath: the oracle the tests hold the kernels to.
+
+Not on any hot path: one point at a time, at ``dps`` decimal digits.
+
+Examples
+--------
+>>> from implicitvox import x, y, sin
+>>> from implicitvox.reference import mp_evaluate
+>>> float(mp_evaluate(sin(x) * y, (1.0, 2.0, 0.0)))
+1.682941969615793
+"""
+from __future__ import annotations
+
+from typing import Any, Optional, Sequence
+
+import mpmath
+
+from .opcodes import OPCODES
+from .tape import compiled_oracle
+
+__all__ = ["mp_evaluate", "PERIODIC_LIMIT", "EXP_LIMIT"]
+
+#: periodic functions of larger arguments are not evaluated (mpmath would
+#: need pi to thousands of digits); the result is None ("not checked")
+PERIODIC_LIMIT = mpmath.mpf(10) ** 15
+#: likewise exp of larger arguments (ln 2 to as many digits)
+EXP_LIMIT = mpmath.mpf(10) ** 4
+_PERIODIC = {"sin", "cos", "tan"}
+
+
+def mp_evaluate(expr: Any, point: Sequence[Any], dps: int = 60) -> Optional[Any]:
+    """Value of ``expr`` at ``point`` to ``dps`` digits; None where undefined
+    (or beyond the limits above)."""
+    with mpmath.workdps(dps):
+        coords = dict(zip("xyz", (c if isinstance(c, mpmath.mpf) else mpmath.mpf(float(c))
+                                  for c in point)))
+        vals: dict[int, Any] = {}
+        for node in expr.walk():
+            if node.op == "var":
+                v = coords[node.param]
+            elif node.op == "const":
+                v = mpmath.mpf(node.param)
+            else:
+                args = [vals[id(a)] for a in node.args]
+                if any(a is None for a in args):
+                    v = None
+                elif node.op in _PERIODIC and abs(args[0]) > PERIODIC_LIMIT:
+                    v = None
+                elif node.op == "exp" and abs(args[0]) > EXP_LIMIT:
+                    v = None
+                elif OPCODES[node.op].oracle:
+                    v = compiled_oracle(node.op, node.param).reference(args, mp_evaluate)
+                else:
+                    v = OPCODES[node.op].reference(args, node.param)
+            vals[id(node)] = v
+        return vals[id(expr)]

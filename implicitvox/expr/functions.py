@@ -1,0 +1,140 @@
+"""DSL functions: ``sqrt, square, abs, exp, log, sin, cos, tan, atan, atan2,
+asin, acos, hypot, min, max, floor, clip``.
+
+Each returns an :class:`~implicitvox.expr.Expr`. ``min`` and ``max`` take any
+number of arguments (or one iterable) and fall back to Python's built-ins when
+no argument is an expression, so ``from implicitvox import *`` does not break
+``min(1, 2)``; the same holds for ``abs``.
+
+Examples
+--------
+>>> from implicitvox import x, y, z, min, max, sqrt
+>>> min(x, y, z)
+min(min(x, y), z)
+>>> min(3, 4)
+3
+>>> max(sqrt(x), 0)
+max(sqrt(x), 0.0)
+"""
+from __future__ import annotations
+
+import builtins
+from typing import Any
+
+from .nodes import Expr, wrap
+
+__all__ = ["sqrt", "square", "abs", "exp", "log", "sin", "cos", "tan", "atan", "atan2",
+           "asin", "acos", "hypot", "min", "max", "floor", "clip"]
+
+
+def _unary(op: str, a: Any) -> Expr:
+    return Expr(op, (wrap(a),))
+
+
+def sqrt(a: Any) -> Expr:
+    """Square root; defined for ``a >= 0``."""
+    return _unary("sqrt", a)
+
+
+def square(a: Any) -> Expr:
+    """``a * a``, with the tight interval ``[0, ...]`` over intervals holding 0."""
+    return _unary("square", a)
+
+
+def abs(a: Any) -> Any:  # noqa: A001 - the DSL shadows the built-in on purpose
+    """Absolute value (Python's ``abs`` for plain numbers)."""
+    if not isinstance(a, Expr):
+        return builtins.abs(a)
+    return _unary("abs", a)
+
+
+def exp(a: Any) -> Expr:
+    """Exponential."""
+    return _unary("exp", a)
+
+
+def log(a: Any) -> Expr:
+    """Natural logarithm; defined for ``a >= 0`` (``log(0) = -inf``)."""
+    return _unary("log", a)
+
+
+def sin(a: Any) -> Expr:
+    """Sine (radians)."""
+    return _unary("sin", a)
+
+
+def cos(a: Any) -> Expr:
+    """Cosine (radians)."""
+    return _unary("cos", a)
+
+
+def tan(a: Any) -> Expr:
+    """Tangent (radians); intervals holding a pole give ``(-inf, inf)``."""
+    return _unary("tan", a)
+
+
+def atan(a: Any) -> Expr:
+    """Arc tangent, in ``(-pi/2, pi/2)``."""
+    return _unary("atan", a)
+
+
+def asin(a: Any) -> Expr:
+    """Arc sine; defined for ``-1 <= a <= 1``."""
+    return _unary("asin", a)
+
+
+def acos(a: Any) -> Expr:
+    """Arc cosine; defined for ``-1 <= a <= 1``."""
+    return _unary("acos", a)
+
+
+def floor(a: Any) -> Expr:
+    """Largest integer not above ``a`` (as a float)."""
+    return _unary("floor", a)
+
+
+def atan2(b: Any, a: Any) -> Expr:
+    """Angle of the point ``(a, b)``: ``atan2(y, x)`` in ``(-pi, pi]`` as numpy's."""
+    return Expr("atan2", (wrap(b), wrap(a)))
+
+
+def hypot(a: Any, b: Any) -> Expr:
+    """``sqrt(a**2 + b**2)`` without overflow."""
+    return Expr("hypot", (wrap(a), wrap(b)))
+
+
+def _nary(op: str, args: tuple[Any, ...], fallback: Any) -> Any:
+    if len(args) == 1 and not isinstance(args[0], Expr):
+        try:
+            args = tuple(args[0])
+        except TypeError:
+            raise TypeError(f"{op}() of a single argument needs an iterable, "
+                            f"got {type(args[0]).__name__}") from None
+    if not args:
+        raise ValueError(f"{op}() needs at least one argument")
+    if not builtins.any(isinstance(a, Expr) for a in args):
+        return fallback(args)
+    nodes = [wrap(a) for a in args]
+    # A left-leaning chain prints like the call; a balanced tree would be
+    # shallower, but tapes are flat, so depth does not matter to evaluation.
+    result = nodes[0]
+    for node in nodes[1:]:
+        result = Expr(op, (result, node))
+    return result
+
+
+def min(*args: Any) -> Any:  # noqa: A001
+    """Minimum of any number of expressions (union of solids)."""
+    return _nary("min", args, builtins.min)
+
+
+def max(*args: Any) -> Any:  # noqa: A001
+    """Maximum of any number of expressions (intersection of solids)."""
+    return _nary("max", args, builtins.max)
+
+
+def clip(a: Any, lo: Any, hi: Any) -> Expr:
+    """``a`` limited to ``[lo, hi]``: ``max(lo, min(a, hi))``."""
+    return Expr("max", (wrap(lo), Expr("min", (wrap(a), wrap(hi)))))
+
+

@@ -1,0 +1,74 @@
+"""The ``Shape`` protocol: what :func:`implicitvox.voxelize` accepts.
+
+A shape has
+
+* ``expr`` - the implicit function (an :class:`~implicitvox.expr.Expr`),
+  negative inside;
+* ``bounds`` (optional) - ``((x0, y0, z0), (x1, y1, z1))`` holding the solid's
+  surface, or ``None``;
+* ``classify_boxes(lo, hi)`` (optional) - an exact test that maps boxes
+  (``(n, 3)`` corner arrays) to :data:`EMPTY`, :data:`FULL` or
+  :data:`AMBIGUOUS`, where AMBIGUOUS means the surface does meet the closed
+  box (Varadhan §5.1). The voxelizer calls it on boxes that interval
+  arithmetic left AMBIGUOUS; at the target depth a voxel is kept iff it says
+  AMBIGUOUS;
+* ``classify_voxels(lo, hi)`` (optional) - the same at the target depth, for
+  shapes whose ``classify_boxes`` may leave a box undecided (AMBIGUOUS) to
+  save work on octants that will be subdivided anyway (:mod:`csg` booleans).
+
+A bare expression is a shape without bounds or exact test.
+"""
+from __future__ import annotations
+
+from typing import Any, Callable, Optional, Protocol, runtime_checkable
+
+import numpy as np
+
+from .nodes import Expr
+
+__all__ = ["Shape", "EMPTY", "FULL", "AMBIGUOUS", "as_shape", "ExprShape", "exact_classifier",
+           "voxel_classifier"]
+
+#: octant states
+EMPTY, FULL, AMBIGUOUS = 0, 1, 2
+
+
+@runtime_checkable
+class Shape(Protocol):
+    """A solid the voxelizer can read (see the module docstring)."""
+
+    expr: Expr
+
+
+class ExprShape:
+    """A shape made of an expression, with optional bounds."""
+
+    def __init__(self, expr: Expr, bounds: Any = None):
+        self.expr = expr
+        self.bounds = bounds
+
+    def __repr__(self) -> str:
+        return f"ExprShape({self.expr!r:.60}, bounds={self.bounds})"
+
+
+def as_shape(obj: Any) -> Any:
+    """Return ``obj`` as a shape: expressions are wrapped, shapes pass through."""
+    if isinstance(obj, Expr):
+        return ExprShape(obj)
+    if isinstance(getattr(obj, "expr", None), Expr):
+        return obj
+    raise TypeError(f"expected an implicitvox expression or a shape with .expr, got "
+                    f"{type(obj).__name__} {obj!r:.60}")
+
+
+def exact_classifier(shape: Any) -> Optional[Callable[[np.ndarray, np.ndarray], np.ndarray]]:
+    """The shape's exact box test, if it has one."""
+    test = getattr(shape, "classify_boxes", None)
+    return test if callable(test) else None
+
+
+def voxel_classifier(shape: Any) -> Optional[Callable[[np.ndarray, np.ndarray], np.ndarray]]:
+    """The shape's exact test at the voxel level (``classify_voxels``, else
+    ``classify_boxes``), if it has one."""
+    test = getattr(shape, "classify_voxels", None)
+    return test if callable(test) else exact_classifier(shape)

@@ -1,0 +1,223 @@
+"""The ``implicitvox`` command.
+
+::
+
+    implicitvox examples
+    implicitvox voxelize --example sinsin34 --resolution 256 --render sinsin.png
+    implicitvox voxelize model.py --resolution 512 --bounds -1 -1 -1 1 1 1 --out model.npz
+    implicitvox voxelize bunny.obj --resolution 256 --interior --render bunny.png
+    implicitvox voxelize bracket.csg --facets openscad --resolution 256 --out bracket.npz
+
+A model file is Python that defines ``shape`` (an expression or a shape);
+errors inside it are reported with the model's own file and line. OpenSCAD
+``.csg`` files and JSON scenes are read by ``csg`` (registered as loaders). A mesh
+file (``.stl``, ``.ply``, ``.obj``, ``.vtk``, ``.vtp``) is voxelized exactly
+(:func:`implicitvox.voxelize_mesh`; ``--interior`` fills closed meshes).
+"""
+from __future__ import annotations
+
+import argparse
+import os
+import runpy
+import sys
+import time
+import traceback
+from typing import Any, Optional, Sequence
+
+from ..octree.subdivide import RECHECK
+
+__all__ = ["main", "ProgressBar", "load_model"]
+
+
+class ProgressBar:
+    """A one-line progress bar on a stream (stderr by default), for ``progress=``."""
+
+    def __init__(self, label: str = "voxelizing", stream: Any = None, width: int = 30):
+        self.label, self.stream, self.width = label, stream or sys.stderr, width
+        self.start = time.perf_counter()
+        self._last = -1
+
+    def __call__(self, share: float) -> None:
+        step = int(share * 1000)
+        if step == self._last:
+            return
+        self._last = step
+        filled = int(share * self.width)
+        bar = "#" * filled + "-" * (self.width - filled)
+        elapsed = time.perf_counter() - self.start
+        self.stream.write(f"\r{self.label} [{bar}] {share * 100:5.1f}% {elapsed:6.1f}s")
+        self.stream.flush()
+
+    def close(self) -> None:
+        self(1.0)
+        self.stream.write("\n")
+        self.stream.flush()
+
+
+class ModelError(Exception):
+    """A model file could not be loaded."""
+
+
+def _loaders() -> dict[str, Any]:
+    """Model loaders registered by other packages (``csg`` registers ``csg`` and ``json``)."""
+    from importlib.metadata import entry_points
+    found = {}
+    for ep in entry_points(group="implicitvox.loaders"):
+        found[ep.name] = ep
+    return {name: _LazyLoader(ep) for name, ep in found.items()}
+
+
+class _LazyLoader:
+    def __init__(self, ep: Any):
+        self.ep = ep
+
+    def __call__(self, path: str, **options: Any) -> Any:
+        return self.ep.load()(path, **options)
+
+
+def load_model(path: str, **options: Any) -> Any:
+    """Run a model file and return its ``shape``.
+
+    ``.py`` files run as Python (they are the user's own code); the error of
+    a failing model names the model's line. Other suffixes go to the loaders
+    registered under the entry-point group ``implicitvox.loaders`` (``csg``
+    registers ``.csg`` and ``.json``); ``options`` are passed to them.
+    """
+    if not os.path.isfile(path):
+        raise ModelError(f"no such model file: {path}")
+    ext = os.path.splitext(path)[1].lower()
+    if ext != ".py":
+        loader = _loaders().get(ext.lstrip("."))
+        if loader is None:
+            known = ", ".join(["py"] + sorted(_loaders()))
+            raise ModelError(f"unsupported model type {ext!r} for {path} (model files: {known}; "
+                             "meshes: stl, ply, obj, vtk, vtp)")
+        return loader(path, **options)
+    try:
+        namespace = runpy.run_path(path, run_name="__implicitvox_model__")
+    except SyntaxError as err:
+        raise ModelError(f"{path}:{err.lineno}:{err.offset or 0}: syntax error: {err.msg}") from None
+    except Exception as err:  # the model's own exception: point at its line
+        frames = [f for f in traceback.extract_tb(err.__traceback__)
+                  if os.path.abspath(f.filename) == os.path.abspath(path)]
+        where = f"{path}:{frames[-1].lineno}" if frames else path
+        line = f"\n    {frames[-1].line}" if frames and frames[-1].line else ""
+        raise ModelError(f"{where}: {type(err).__name__}: {err}{line}") from None
+    if "shape" not in namespace:
+        raise ModelError(f"{path} defines no `shape` (assign the solid to a variable named shape)")
+    return namespace["shape"]
+
+
+def _parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(prog="implicitvox",
+                                     description="Robust voxelization of implicit solids.")
+    sub = parser.add_subparsers(dest="command", required=True)
+    sub.add_parser("examples", help="list the built-in example models")
+    vox = sub.add_parser("voxelize", help="voxelize a model")
+    vox.add_argument("model", nargs="?",
+                     help="a .py file that defines `shape`, or a mesh (.stl .ply .obj .vtk .vtp)")
+    vox.add_argument("--example", help="a built-in example instead of a model file")
+    vox.add_argument("--resolution", type=int, default=256, help="voxels along the longest side")
+    vox.add_argument("--bounds", type=float, nargs=6, metavar=("X0", "Y0", "Z0", "X1", "Y1", "Z1"))
+    vox.add_argument("--interior", action="store_true", help="also find interior octants")
+    vox.add_argument("--facets", choices=["true", "openscad"], default="true",
+                     help=".csg models: true curves, or OpenSCAD's own facets")
+    vox.add_argument("--normals", action="store_true", help="store normals")
+    vox.add_argument("--mean-value", action="store_true",
+                     help="tighter: mean value form on ambiguous octants (about 3x the time)")
+    vox.add_argument("--subvoxel", type=int, default=0, metavar="K",
+                     help="tighter: keep a voxel only if a sub-voxel K levels down is ambiguous")
+    vox.add_argument("--recheck", type=float, default=RECHECK, metavar="STRENGTH",
+                     help="recheck on sub-voxels the voxels predicted to be false "
+                          f"(default {RECHECK}; 0 = off, up to 4 = nearly all)")
+    vox.add_argument("--out", help="write .npz, .vti or .binvox")
+    vox.add_argument("--render", metavar="PNG", help="render a picture")
+    vox.add_argument("--max-memory", type=float, metavar="GIB", help="refuse runs estimated above")
+    vox.add_argument("--quiet", action="store_true", help="no progress bar")
+    return parser
+
+
+def _check_writable(path: Optional[str], what: str) -> None:
+    if path is None:
+        return
+    folder = os.path.dirname(os.path.abspath(path)) or "."
+    if not os.path.isdir(folder) or not os.access(folder, os.W_OK):
+        raise ModelError(f"cannot write {what} {path}: folder {folder} does not exist "
+                         "or is not writable")
+
+
+def _voxelize(args: argparse.Namespace) -> int:
+    from ..expr.examples import example
+    from ..voxelizers.implicit import voxelize
+
+    from ..mesh.inputs import MESH_SUFFIXES
+    from ..voxelizers.mesh import voxelize_mesh
+
+    if (args.model is None) == (args.example is None):
+        raise ModelError("give a model file or --example NAME (one of them)")
+    is_mesh = args.model is not None and args.model.lower().endswith(MESH_SUFFIXES)
+    shape = None
+    if not is_mesh:
+        shape = example(args.example) if args.example else \
+            load_model(args.model, **({"facets": args.facets} if not
+                                      args.model.endswith(".py") else {}))
+    _check_writable(args.out, "--out")
+    _check_writable(args.render, "--render")
+    bounds = None
+    if args.bounds:
+        bounds = (tuple(args.bounds[:3]), tuple(args.bounds[3:]))
+    bar = None if args.quiet else ProgressBar()
+    max_memory = None if args.max_memory is None else int(args.max_memory * 2**30)
+    if is_mesh:
+        if args.normals or args.mean_value or args.subvoxel:
+            raise ModelError("--normals, --mean-value and --subvoxel apply to implicit models, "
+                             "not to meshes")
+        vox = voxelize_mesh(args.model, args.resolution, bounds, solid=args.interior,
+                            progress=bar, max_memory=max_memory)
+    else:
+        if bounds is None and getattr(shape, "bounds", None) is not None:
+            bounds = _padded(shape.bounds)
+        vox = voxelize(shape, bounds, args.resolution, interior=args.interior,
+                       normals=args.normals or bool(args.render), progress=bar,
+                       max_memory=max_memory, mean_value=args.mean_value,
+                       subvoxel=args.subvoxel, recheck=args.recheck)
+    if bar:
+        bar.close()
+    meta = vox.metadata
+    print(f"{vox.count:,} surface voxels at {'x'.join(map(str, vox.resolution))} in "
+          f"{meta['seconds_total']:.2f} s; octree {vox.octree.nbytes:,} bytes")
+    if args.interior:
+        print(f"{vox.interior_count:,} interior voxels")
+    if args.out:
+        print(f"wrote {vox.save(args.out)}")
+    if args.render:
+        name = args.example or os.path.basename(args.model)
+        title = f"{name} {'x'.join(map(str, vox.resolution))}"
+        print(f"rendered {vox.render(args.render, title=title)}")
+    return 0
+
+
+def _padded(bounds: Any) -> Any:
+    """A shape's own bounds grown by 1% (its surface off the grid's edge)."""
+    lo, hi = bounds
+    pad = 0.01 * max(b - a for a, b in zip(lo, hi))
+    return tuple(a - pad for a in lo), tuple(b + pad for b in hi)
+
+
+def main(argv: Optional[Sequence[str]] = None) -> int:
+    """Entry point; returns the exit status (2 for bad input)."""
+    args = _parser().parse_args(argv)
+    try:
+        if args.command == "examples":
+            from ..expr.examples import EXAMPLES
+            for name, (description, _) in EXAMPLES.items():
+                print(f"{name:<14}{description}")
+            return 0
+        return _voxelize(args)
+    except (ModelError, ValueError, TypeError, MemoryError, FileNotFoundError) as err:
+        print(f"implicitvox: error: {err}", file=sys.stderr)
+        return 2
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,203 @@
+"""Files: ``.npz`` (lossless: octree, grid, interior, payload, metadata),
+``.vti`` (VTK image data, dense) and ``.binvox`` (run-length encoded, dense).
+
+Examples
+--------
+>>> import os, tempfile
+>>> import implicitvox as iv
+>>> from implicitvox import x, y, z
+>>> vox = iv.voxelize(x**2 + y**2 + z**2 - 1, bounds=((-1.2,) * 3, (1.2,) * 3), resolution=8)
+>>> path = os.path.join(tempfile.mkdtemp(), "ball.npz")
+>>> back = iv.load(vox.save(path))
+>>> bool((back.coords() == vox.coords()).all())
+True
+"""
+from __future__ import annotations
+
+import json
+import os
+from typing import Any
+
+import numpy as np
+
+from ..octree.grid import Grid
+from ..octree.store import Octree
+from ..octree.voxels import DEFAULT_DENSE_LIMIT, Voxels
+
+__all__ = ["save", "load", "FORMATS"]
+
+FORMATS = (".npz", ".vti", ".binvox")
+_NPZ_VERSION = 1
+
+
+def _suffix(path: str) -> str:
+    ext = os.path.splitext(str(path))[1].lower()
+    if ext not in FORMATS:
+        raise ValueError(f"unknown voxel file type {ext!r} for {path!r}; use one of {FORMATS}")
+    return ext
+
+
+def _writable(path: str) -> None:
+    folder = os.path.dirname(os.path.abspath(path))
+    if not os.path.isdir(folder):
+        raise ValueError(f"cannot write {path!r}: folder {folder!r} does not exist")
+    if not os.access(folder, os.W_OK):
+        raise ValueError(f"cannot write {path!r}: folder {folder!r} is not writable")
+
+
+def save(vox: Voxels, path: str) -> str:
+    """Write ``vox`` to ``path``; the suffix picks the format. Returns the path."""
+    ext = _suffix(path)
+    _writable(path)
+    {".npz": _save_npz, ".vti": _save_vti, ".binvox": _save_binvox}[ext](vox, str(path))
+    return str(path)
+
+
+def load(path: str) -> Voxels:
+    """Read voxels written by :func:`save` (``.npz``, ``.vti`` or ``.binvox``)."""
+    ext = _suffix(path)
+    if not os.path.isfile(path):
+        raise FileNotFoundError(f"no such voxel file: {path!r}")
+    return {".npz": _load_npz, ".vti": _load_vti, ".binvox": _load_binvox}[ext](str(path))
+
+
+# -- npz ------------------------------------------------------------------------------
+def _save_npz(vox: Voxels, path: str) -> None:
+    t = vox.octree
+    arrays: dict[str, np.ndarray] = {
+        "format": np.array([_NPZ_VERSION]),
+        "origin": np.array(vox.grid.origin), "voxel_size": np.array(vox.grid.voxel_size),
+        "shape": np.array(vox.grid.shape), "depth": np.array([t.depth]),
+        "metadata": np.array(json.dumps(vox.metadata, default=str)),
+    }
+    for level, m in enumerate(t.masks):
+        arrays[f"masks_{level}"] = m
+    for level, f in enumerate(t.first):
+        arrays[f"first_{level}"] = f
+    for name, v in t.payload.items():
+        arrays[f"payload_{name}"] = v
+    for level, c in vox.interior.items():
+        arrays[f"interior_{level}"] = c
+    with open(path, "wb") as fh:
+        np.savez_compressed(fh, **arrays)
+
+
+def _load_npz(path: str) -> Voxels:
+    try:
+        data = np.load(path, allow_pickle=False)
+    except (ValueError, OSError) as err:
+        raise ValueError(f"{path!r} is not an implicitvox .npz file: {err}") from None
+    with data:
+        if "format" not in data or int(data["format"][0]) != _NPZ_VERSION:
+            raise ValueError(f"{path!r} is not an implicitvox .npz file (version {_NPZ_VERSION})")
+        depth = int(data["depth"][0])
+        masks = [data[f"masks_{lvl}"] for lvl in range(depth) if f"masks_{lvl}" in data]
+        if depth == 0 and "masks_0" in data:
+            masks = [data["masks_0"]]
+        first = [data[f"first_{lvl}"] for lvl in range(max(depth - 1, 0))] if masks else []
+        payload = {k[len("payload_"):]: data[k] for k in data.files if k.startswith("payload_")}
+        interior = {int(k[len("interior_"):]): data[k] for k in data.files
+                    if k.startswith("interior_")}
+        grid = Grid(tuple(data["origin"].tolist()), tuple(data["voxel_size"].tolist()),
+                    tuple(int(v) for v in data["shape"]))
+        metadata = json.loads(str(data["metadata"]))
+    return Voxels(grid, Octree(depth, masks, first, payload), interior, metadata)
+
+
+# -- vti -----------------------------------------------------------------------------
+def _save_vti(vox: Voxels, path: str) -> None:
+    import pyvista as pv
+    image = pv.ImageData(dimensions=np.array(vox.grid.shape) + 1, spacing=vox.grid.voxel_size,
+                         origin=vox.grid.origin)
+    surface = vox.to_dense(interior=False)
+    image.cell_data["surface"] = surface.ravel(order="F").astype(np.uint8)
+    if vox.interior:
+        solid = vox.to_dense(interior=True) & ~surface
+        image.cell_data["interior"] = solid.ravel(order="F").astype(np.uint8)
+    image.save(path)
+
+
+def _load_vti(path: str) -> Voxels:
+    import pyvista as pv
+    image = pv.read(path)
+    if "surface" not in image.cell_data:
+        raise ValueError(f"{path!r} has no 'surface' cell array (not written by implicitvox)")
+    shape = tuple(int(d) - 1 for d in image.dimensions)
+    grid = Grid(tuple(image.origin), tuple(image.spacing), shape)
+    surface = np.asarray(image.cell_data["surface"]).reshape(shape, order="F").astype(bool)
+    interior = {}
+    if "interior" in image.cell_data:
+        inside = np.asarray(image.cell_data["interior"]).reshape(shape, order="F").astype(bool)
+        interior = {grid.depth: np.argwhere(inside).astype(np.int32)}
+    tree = Octree.from_coords(np.argwhere(surface), grid.depth)
+    return Voxels(grid, tree, interior, {"source": os.path.basename(path)})
+
+
+# -- binvox --------------------------------------------------------------------------
+def _save_binvox(vox: Voxels, path: str) -> None:
+    """binvox 1: a cubic ``dim^3`` grid, voxels in x-z-y order (y fastest), RLE bytes."""
+    dim = max(vox.grid.shape)
+    if dim ** 3 > DEFAULT_DENSE_LIMIT:
+        raise MemoryError(f"binvox is dense: {dim}^3 voxels is too large")
+    dense = np.zeros((dim, dim, dim), dtype=bool)
+    n0, n1, n2 = vox.grid.shape
+    dense[:n0, :n1, :n2] = vox.to_dense(interior=bool(vox.interior))
+    flat = dense.transpose(0, 2, 1).ravel()  # index = x * dim*dim + z * dim + y
+    scale = max(h * dim for h in vox.grid.voxel_size)
+    with open(path, "wb") as fh:
+        fh.write(b"#binvox 1\n")
+        fh.write(f"dim {dim} {dim} {dim}\n".encode())
+        fh.write("translate {} {} {}\n".format(*vox.grid.origin).encode())
+        fh.write(f"scale {scale!r}\n".encode())
+        fh.write(b"data\n")
+        fh.write(_rle(flat))
+
+
+def _rle(flat: np.ndarray) -> bytes:
+    """binvox run-length pairs (value, count <= 255), vectorized."""
+    if flat.size == 0:
+        return b""
+    change = np.flatnonzero(flat[1:] != flat[:-1]) + 1
+    starts = np.r_[0, change]
+    lengths = np.diff(np.r_[starts, flat.size])
+    values = flat[starts].astype(np.uint8)
+    pieces = -(-lengths // 255)  # runs longer than 255 split
+    rep_values = np.repeat(values, pieces)
+    counts = np.full(pieces.sum(), 255, dtype=np.int64)
+    last = np.cumsum(pieces) - 1
+    counts[last] = lengths - 255 * (pieces - 1)
+    out = np.empty(2 * len(counts), dtype=np.uint8)
+    out[0::2], out[1::2] = rep_values, counts
+    return out.tobytes()
+
+
+def _load_binvox(path: str) -> Voxels:
+    with open(path, "rb") as fh:
+        header: dict[str, Any] = {}
+        if fh.readline().strip() != b"#binvox 1":
+            raise ValueError(f"{path!r} is not a binvox 1 file")
+        while True:
+            line = fh.readline()
+            if not line:
+                raise ValueError(f"{path!r}: binvox header ends before 'data'")
+            words = line.decode("ascii", "replace").split()
+            if words and words[0] == "data":
+                break
+            if words:
+                header[words[0]] = words[1:]
+        raw = np.frombuffer(fh.read(), dtype=np.uint8)
+    try:
+        dims = [int(v) for v in header["dim"]]
+        origin = tuple(float(v) for v in header.get("translate", [0, 0, 0]))
+        scale = float(header.get("scale", [1.0])[0])
+    except (KeyError, ValueError, IndexError):
+        raise ValueError(f"{path!r}: bad binvox header {header}") from None
+    values, counts = raw[0::2], raw[1::2].astype(np.int64)
+    flat = np.repeat(values.astype(bool), counts)
+    if flat.size != dims[0] * dims[1] * dims[2]:
+        raise ValueError(f"{path!r}: {flat.size} voxels in the data, header says {dims}")
+    dense = flat.reshape(dims[0], dims[2], dims[1]).transpose(0, 2, 1)
+    size = scale / max(dims)
+    grid = Grid(origin, (size, size, size), tuple(dims))
+    tree = Octree.from_coords(np.argwhere(dense), grid.depth)
+    return Voxels(grid, tree, {}, {"source": os.path.basename(path)})

@@ -1,0 +1,451 @@
+"""Robust octree subdivision: interval arithmetic on a frontier of octants.
+
+Stolte §2 (Fig. 1): evaluate the inclusion function over an octant; if the
+interval excludes 0 the surface does not pass through it and the octant is
+rejected, otherwise it is subdivided, down to the voxel level. Every octant
+is one of
+
+* EMPTY - ``flo > 0`` (or the function is undefined over it): outside;
+* FULL - ``fhi < 0``: inside the solid, kept as one coarse octant (interior);
+* AMBIGUOUS - neither: subdivided; at the target depth, a surface voxel.
+
+Since each inclusion function encloses the exact range, an octant the
+surface meets is never EMPTY or FULL: no surface voxel is ever missed.
+
+The frontier is processed as a stack of chunks of octants (at most
+``chunk`` octants, one interval evaluation each), deepest first, so memory
+stays bounded by ``8 * chunk * depth`` octants whatever the resolution. Each
+chunk is an independent set of subtrees (the unit a parallel driver hands
+out; Stolte §5.2). Octants travel as Morton codes (a child is ``parent << 3
+| slot``), so the surface voxels come out ready for the pointer octree, and
+the interval evaluation runs in float32 where
+:func:`implicitvox.precision.interval_dtype` allows it (about 3 times
+faster, still rounded outward).
+"""
+from __future__ import annotations
+
+import functools
+from dataclasses import dataclass, field
+from typing import Any, Callable, Optional
+
+import numpy as np
+
+from ..eval.function import Function
+from .grid import Grid
+from . import morton
+from ..eval.mean_value import mean_value_enclosure
+from .precision import interval_dtype, level_dtype
+from ..interval.float32 import outward_float32
+from ..eval.precision import supports_float32
+from ..expr.shape import AMBIGUOUS, EMPTY, FULL
+
+__all__ = ["subdivide", "Subdivision", "classify", "suspect_voxels", "recheck_voxels", "CHUNK",
+           "RECHECK"]
+
+#: octants classified per interval evaluation
+CHUNK = 1 << 17
+#: default strength of the recheck (:func:`suspect_voxels`; measured in
+#: tests/benchmarks/bench_voxelize.py): 1/4 selects the voxels whose sub-voxels
+#: are predicted to settle them
+RECHECK = 0.25
+_CHILD_OFFSETS = morton.CORNERS.astype(np.int32)
+
+
+@dataclass
+class Subdivision:
+    """What a subdivision found."""
+
+    #: Morton codes (uint64) of the surface voxels, in no particular order
+    codes: np.ndarray
+    #: FULL octants per level: level -> (m, 3) int32 coordinates at that level
+    interior: dict[int, np.ndarray] = field(default_factory=dict)
+    #: octants classified (boxes evaluated)
+    evaluated: int = 0
+
+    @property
+    def surface(self) -> np.ndarray:
+        """The surface voxels' coordinates, (n, 3) int32, in the order of :attr:`codes`."""
+        return _unpack(self.codes)
+
+
+def _states(flo: np.ndarray, fhi: np.ndarray) -> np.ndarray:
+    """EMPTY where ``flo > 0`` (also the empty interval ``(inf, -inf)``: undefined),
+    else FULL where ``fhi < 0``, else AMBIGUOUS; branch-free (the masks are random)."""
+    state = np.subtract(AMBIGUOUS, fhi < 0.0, dtype=np.int8)   # FULL = AMBIGUOUS - 1
+    state *= flo <= 0.0                                         # EMPTY = 0
+    return state
+
+
+def classify(func: Function, grid: Grid, level: int, coords: np.ndarray,
+             exact: Optional[Callable[[np.ndarray, np.ndarray], np.ndarray]] = None,
+             mean_value: bool = False, dtype=None) -> np.ndarray:
+    """States (int8) of octants ``coords`` at ``level``: EMPTY, FULL or AMBIGUOUS.
+
+    The natural interval extension decides first; octants it leaves
+    AMBIGUOUS get the mean value form (:mod:`implicitvox.mean_value`) when
+    ``mean_value``, then the shape's exact test. A box's state depends on the
+    box alone, not on the level or the run, so ``Voxels.refine`` matches a
+    direct voxelization: the natural extension runs in the float type that
+    :func:`implicitvox.precision.interval_dtype` picks for the box size
+    (``dtype`` None), or in ``dtype``.
+    """
+    lo, hi = grid.octant_boxes(level, coords)
+    if dtype is None:
+        dtype = interval_dtype(func.tape, grid, level)
+    flo, fhi = func.interval_columns(lo, hi, dtype)
+    state = _states(flo, fhi)
+    return _tighten(func, lo, hi, flo, fhi, state, exact, mean_value)
+
+
+def _tighten(func: Function, lo, hi, flo: np.ndarray, fhi: np.ndarray, state: np.ndarray,
+             exact, mean_value: bool) -> np.ndarray:
+    """Settle the AMBIGUOUS states further: the mean value form (reusing the
+    natural bounds ``flo, fhi`` already computed), then the exact test."""
+    if mean_value:
+        amb = np.flatnonzero(state == AMBIGUOUS)
+        if amb.size:
+            sub_lo, sub_hi = tuple(c[amb] for c in lo), tuple(c[amb] for c in hi)
+            mlo, mhi = mean_value_enclosure(func.tape, sub_lo, sub_hi, (flo[amb], fhi[amb]))
+            state[amb] = _states(mlo, mhi)
+    if exact is not None:
+        amb = np.flatnonzero(state == AMBIGUOUS)
+        if amb.size:
+            lo_arr = np.stack([c[amb] for c in lo], axis=1)
+            hi_arr = np.stack([c[amb] for c in hi], axis=1)
+            state[amb] = exact(lo_arr, hi_arr)
+    return state
+
+
+_BROADCAST = [(1, 1, 2, -1), (1, 2, 1, -1), (2, 1, 1, -1)]
+
+# Octants on the stack are Morton codes (uint64, :mod:`implicitvox.morton`): a
+# child is ``parent << 3 | slot``, selecting kept children gathers one integer
+# per octant, and the surface voxels come out ready for the octree.
+_SLOTS = np.arange(8, dtype=np.uint64)
+_THREE = np.uint64(3)
+
+
+def _pack(coords: np.ndarray) -> np.ndarray:
+    return morton.encode(np.asarray(coords).reshape(-1, 3))
+
+
+def _axes(keys: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    c = morton.decode(keys)
+    return c[:, 0], c[:, 1], c[:, 2]
+
+
+def _unpack(keys: np.ndarray) -> np.ndarray:
+    return morton.decode(keys).astype(np.int32)
+
+
+def _child_boxes(grid: Grid, level: int, parents: tuple[np.ndarray, ...], single: bool = False):
+    """Per-axis bounds of the children of octants ``parents`` (per-axis
+    coordinates), shaped to broadcast: ``x (1, 1, 2, m)``, ``y (1, 2, 1, m)``,
+    ``z (2, 1, 1, m)``; the (2, 2, 2, m) result reshapes to ``(8, m)`` in
+    child order ``x + 2y + 4z``. Children past the grid get degenerate boxes
+    on its edge (they are dropped after). ``single``: float32 bounds rounded
+    outward (the same values :func:`implicitvox.precision.outward_float32`
+    gives the float64 ones). Looked up in :func:`_child_edges` (one gather
+    per axis and end) up to grids of ``_EDGE_TABLE_LIMIT`` voxels a side."""
+    lo, hi = [], []
+    for a in range(3):
+        if grid.shape[a] < _EDGE_TABLE_LIMIT:
+            low, high = _child_edges(grid, level, a, single)
+            lo.append(np.take(low, parents[a], axis=1).reshape(_BROADCAST[a]))
+            hi.append(np.take(high, parents[a], axis=1).reshape(_BROADCAST[a]))
+        else:
+            first, last = _child_edge_indices(grid, level, a, parents[a])
+            low, high = grid.edge(a, first), grid.edge(a, last)
+            if single:
+                low, high = outward_float32(low, high)
+            lo.append(low.reshape(_BROADCAST[a]))
+            hi.append(high.reshape(_BROADCAST[a]))
+    return tuple(lo), tuple(hi)
+
+
+_HALVES = np.array([[0], [1]], dtype=np.int64)
+#: voxels per axis up to which the child edges are tabulated (tables of at most
+#: 2 * 2**15 values per level and axis)
+_EDGE_TABLE_LIMIT = 1 << 16
+
+
+def _child_edge_indices(grid: Grid, level: int, axis: int, parents: np.ndarray):
+    """Voxel indices of the lower and upper edges (2, m) along ``axis`` of the
+    two halves of octants at ``level`` with coordinates ``parents``, clamped
+    to the grid."""
+    scale = 1 << (grid.depth - level - 1)
+    first = (np.asarray(parents, dtype=np.int64)[None, :] * 2 + _HALVES) * scale
+    return np.minimum(first, grid.shape[axis]), np.minimum(first + scale, grid.shape[axis])
+
+
+@functools.lru_cache(maxsize=256)
+def _child_edges(grid: Grid, level: int, axis: int, single: bool
+                 ) -> tuple[np.ndarray, np.ndarray]:
+    """The lower and upper edges along ``axis`` of the two halves of every
+    octant at ``level`` (arrays (2, 2**level), by octant coordinate), in
+    float64 or rounded outward to float32 (``single``)."""
+    first, last = _child_edge_indices(grid, level, axis, np.arange(1 << level))
+    low, high = grid.edge(axis, first), grid.edge(axis, last)
+    if single:
+        low, high = outward_float32(low, high)
+    return low, high
+
+
+def _child_states(func: Function, grid: Grid, level: int, parents: np.ndarray, dtype):
+    """States (8, m) of the children of octants ``parents`` (Morton codes) at
+    ``level``, child-major, EMPTY past the grid; and their bounds (8 m) and
+    the number of children inside the grid."""
+    axes = _axes(parents)
+    lo, hi = _child_boxes(grid, level, axes, single=np.dtype(dtype) == np.float32)
+    flo, fhi = func.interval_columns(lo, hi, dtype, native=True)
+    flo, fhi = flo.reshape(-1), fhi.reshape(-1)     # child-major: index = child * m + parent
+    state = _states(flo, fhi)
+    classified = state.size
+    inside = _inside_children(grid, level + 1, axes)
+    if inside is not None:
+        state *= inside
+        classified = int(np.count_nonzero(inside))
+    return state, flo, fhi, classified, inside
+
+
+def classify_children(func: Function, grid: Grid, level: int, parents: np.ndarray,
+                      exact=None, mean_value: bool = False, dtype=np.float64,
+                      full: bool = False, recheck: float = 0.0
+                      ) -> tuple[np.ndarray, Optional[np.ndarray], np.ndarray, int]:
+    """The AMBIGUOUS children of octants at ``level`` (and the FULL ones if ``full``).
+
+    ``parents`` and the children returned are Morton codes. One broadcast
+    interval evaluation for all children (see :func:`_child_boxes`), in
+    ``dtype``; the mean value form and the exact test then run on the
+    AMBIGUOUS ones, as in :func:`classify`. At the voxel level, without an
+    exact test, the AMBIGUOUS children that :func:`suspect_voxels` picks
+    (``recheck`` > 0) are *suspects* (see :func:`recheck_voxels`), returned
+    apart. Returns ``(ambiguous, full, suspects, classified)``: ``full`` None
+    unless asked for, ``classified`` the number of boxes classified.
+    """
+    state, flo, fhi, classified, inside = _child_states(func, grid, level, parents, dtype)
+    kids = ((parents << _THREE)[None, :] | _SLOTS[:, None]).reshape(-1)
+    if mean_value or exact is not None:
+        amb = np.flatnonzero(state == AMBIGUOUS)
+        if amb.size:
+            # the natural bounds are known: only the boxes are rebuilt, as columns
+            box_lo, box_hi = grid.octant_boxes(level + 1, _unpack(kids[amb]))
+            state[amb] = _tighten(func, box_lo, box_hi, flo[amb].astype(np.float64),
+                                  fhi[amb].astype(np.float64), state[amb], exact, mean_value)
+    ambiguous = state == AMBIGUOUS
+    suspects = _NONE
+    if recheck > 0.0 and exact is None and level + 1 == grid.depth:
+        near_end = suspect_voxels(flo, fhi, len(parents), recheck, inside)
+        near_end &= ambiguous
+        suspects = kids[np.flatnonzero(near_end)]
+        ambiguous &= ~near_end
+    return (kids[np.flatnonzero(ambiguous)],
+            kids[np.flatnonzero(state == FULL)] if full else None, suspects, classified)
+
+
+_NONE = np.zeros(0, dtype=np.uint64)
+
+
+def suspect_voxels(flo: np.ndarray, fhi: np.ndarray, m: int, recheck: float,
+                   inside: Optional[np.ndarray] = None) -> np.ndarray:
+    """Which voxels (the ``8 m`` children of ``m`` octants, child-major, with
+    enclosures ``[flo, fhi]``) to recheck on their sub-voxels.
+
+    A natural interval enclosure of width ``W`` overestimates the true range
+    ``w`` of ``f`` over a voxel (by the triangle inequality, where the terms of
+    ``f`` partly cancel; Stolte §1). The 8 children of one octant sit on a
+    2 x 2 x 2 lattice one voxel apart, so the spread of their enclosures'
+    midpoints (each ``f`` at a child centre, to second order) estimates ``w``
+    without further evaluation: ``rho = spread / W`` (for linear ``f``, exactly
+    ``w / W``). A sub-voxel's enclosure is about ``W / 2`` wide and centred up
+    to ``w / 4`` nearer 0 than the voxel's midpoint ``c``, so all 8 exclude 0
+    when ``|c| > (W + w) / 4``: when 0 lies within ``(1 - rho) / 4`` of the
+    width from an end. A voxel is a suspect when 0 lies within ``recheck (1 -
+    rho) W`` of an end: ``recheck = 1/4`` is the prediction itself, larger
+    values recheck more. Children outside the grid (``inside`` False) do not
+    count in the spread. For affine ``f`` the prediction is exact
+    (``tests/test_voxelize.py``).
+
+    Examples
+    --------
+    One octant whose 8 children have enclosures of width 1 and midpoints
+    spread over 0.49 (``rho = 0.49``): the suspects are those with 0 within
+    ``0.25 * 0.51`` of an end.
+
+    >>> import numpy as np
+    >>> mid = np.array([0.0, 0.1, 0.2, 0.3, 0.4, 0.45, 0.48, 0.49])
+    >>> suspect_voxels(mid - 0.5, mid + 0.5, 1, 0.25)
+    array([False, False, False, False,  True,  True,  True,  True])
+    """
+    with np.errstate(invalid="ignore"):   # in float64 also for float32 bounds (exactly)
+        twice_mid = np.add(flo, fhi, dtype=np.float64).reshape(8, m)
+        if inside is not None:
+            twice_mid[~inside.reshape(8, m)] = np.nan
+        spread = np.fmax.reduce(twice_mid, axis=0)          # fmax, fmin: NaN ignored
+        spread -= np.fmin.reduce(twice_mid, axis=0)
+        spread *= 0.5
+        margin = np.subtract(fhi, flo, dtype=np.float64)
+        margin.reshape(8, m)[...] -= spread
+        margin *= recheck
+        return np.minimum(-flo, fhi) <= margin
+
+
+def recheck_voxels(func: Function, grid: Grid, codes: np.ndarray, dtype
+                   ) -> tuple[np.ndarray, np.ndarray, int]:
+    """Settle suspect voxels (Morton codes at ``grid.depth``) on their 8 sub-voxels.
+
+    A suspect (:func:`suspect_voxels`) is a voxel whose enclosure reaches 0
+    only by the amount it overestimates the range of ``f`` (natural
+    interval extensions converge linearly, Stolte §2), as predicted from its
+    siblings. Its 8 halves, being smaller, get tighter enclosures: it
+    stays AMBIGUOUS if one of them is, and is FULL (EMPTY) if all are, since
+    any two halves share a point and a FULL one cannot touch an EMPTY one.
+    This is ``subvoxel=1`` (Stolte's sub-voxel refinement) on the few voxels
+    it can change: as sound, and cheap. ``dtype``: the voxels' float type.
+    Returns ``(still AMBIGUOUS, FULL, boxes classified)``.
+    """
+    fine = grid.finer(1)
+    sub_dtype = level_dtype(fine, fine.depth) if np.dtype(dtype) == np.float32 else np.float64
+    state, _, _, classified, _ = _child_states(func, fine, grid.depth, codes, sub_dtype)
+    state = state.reshape(8, -1)
+    met = (state == AMBIGUOUS).any(axis=0)
+    inside = (state == FULL).all(axis=0)
+    return codes[met], codes[inside], classified
+
+
+def _inside_children(grid: Grid, level: int, axes) -> Optional[np.ndarray]:
+    """Which children (child-major, ``8 m``) at ``level`` of the parents with
+    coordinates ``axes`` meet the grid (None: all)."""
+    if all(n == 1 << grid.depth for n in grid.shape):
+        return None
+    limits = [-(-n // (1 << (grid.depth - level))) for n in grid.shape]  # octants per axis
+    inside = np.ones((8, len(axes[0])), dtype=bool)
+    for a in range(3):
+        inside &= (axes[a][None, :] * 2 + _CHILD_OFFSETS[:, a, None]) < limits[a]
+    return inside.reshape(-1)
+
+
+class _Progress:
+    """Share of the estimated work done, reported non-decreasing.
+
+    The number of octants to classify grows about 4 times per level near a
+    surface (Stolte §4.1.3), so the children of ``m`` pending octants at level
+    ``l`` are estimated at ``8 m (4**(depth - l) - 1) / 3`` classifications.
+    """
+
+    def __init__(self, hook: Optional[Callable[[float], Any]], depth: int):
+        self.hook, self.depth, self.done, self.last = hook, depth, 0, 0.0
+
+    def estimate(self, m: int, level: int) -> float:
+        return 8.0 * m * (4.0 ** (self.depth - level) - 1.0) / 3.0
+
+    def report(self, stack: list) -> None:
+        if self.hook is None:
+            return
+        pending = sum(self.estimate(len(c), lvl) for lvl, c in stack)
+        share = self.done / (self.done + pending) if pending else 1.0
+        self.last = max(self.last, min(share, 1.0))
+        self.hook(self.last)
+
+
+def subdivide(func: Function, grid: Grid, *, start: Optional[tuple[int, np.ndarray]] = None,
+              interior: bool = False, exact=None, progress=None, chunk: int = CHUNK,
+              mean_value: bool = False, exact_voxels=None,
+              recheck: float = RECHECK) -> Subdivision:
+    """Classify octants from the root (or from ``start``) down to the voxels.
+
+    Parameters
+    ----------
+    func : Function
+        The compiled implicit function.
+    grid : Grid
+        The voxel grid; the octree has ``grid.depth`` levels below the root.
+    start : (level, coords), optional
+        AMBIGUOUS octants at ``level`` to continue from (default: classify the
+        root). ``Voxels.refine`` passes the stored surface voxels.
+    interior : bool, default: False
+        Record FULL octants.
+    exact : callable, optional
+        The shape's exact box test, applied to interval-AMBIGUOUS octants.
+    exact_voxels : callable, optional
+        Its form for the target depth (default: ``exact``), which must decide
+        every box (see :func:`implicitvox.shape.voxel_classifier`).
+    progress : callable, optional
+        Called with the estimated share of work done, in [0, 1].
+    chunk : int
+        Octants classified per step (the children of ``chunk // 8`` parents).
+    mean_value : bool, default: False
+        Tighten AMBIGUOUS octants with the mean value form.
+    recheck : float, default: RECHECK
+        Strength of the recheck of suspect voxels on their 8 sub-voxels
+        (:func:`suspect_voxels`, :func:`recheck_voxels`); 0 turns it off.
+    """
+    depth = grid.depth
+    per_step = max(1, chunk // 8)
+    if exact_voxels is None:
+        exact_voxels = exact
+    surface: list[np.ndarray] = []
+    interior_parts: dict[int, list[np.ndarray]] = {}
+    stack: list[tuple[int, np.ndarray]] = []
+    evaluated = 0
+    if start is None:
+        root = np.zeros((1, 3), dtype=np.int32)
+        state = classify(func, grid, 0, root, exact_voxels if depth == 0 else exact, mean_value)
+        evaluated = 1
+        if state[0] == FULL and interior:
+            interior_parts[0] = [_pack(root)]
+        elif state[0] == AMBIGUOUS:
+            if depth == 0:
+                surface.append(_pack(root))
+            else:
+                stack.append((0, _pack(root)))
+    else:
+        level0, coords0 = start
+        keys0 = _pack(coords0)
+        stack.extend((level0, keys0[s:s + per_step]) for s in range(0, len(keys0), per_step))
+    meter = _Progress(progress, depth)
+    single = supports_float32(func.tape)
+    voxel_dtype = level_dtype(grid, depth) if single else np.float64
+    suspects: list[np.ndarray] = []
+    pending = 0
+
+    def settle_suspects() -> int:
+        codes = np.concatenate(suspects)
+        suspects.clear()
+        met, full, classified = recheck_voxels(func, grid, codes, voxel_dtype)
+        surface.append(met)
+        if interior and len(full):
+            interior_parts.setdefault(depth, []).append(full)
+        return classified
+
+    while stack:
+        level, parents = stack.pop()
+        ambiguous, full, suspect, classified = classify_children(
+            func, grid, level, parents, exact_voxels if level + 1 == depth else exact, mean_value,
+            level_dtype(grid, level + 1) if single else np.float64, full=interior,
+            recheck=recheck)
+        if full is not None and len(full):
+            interior_parts.setdefault(level + 1, []).append(full)
+        if len(suspect):   # rechecked in batches, for full-sized evaluations
+            suspects.append(suspect)
+            pending += len(suspect)
+            if pending >= per_step or not stack:
+                classified += settle_suspects()
+                pending = 0
+        evaluated += classified
+        meter.done += classified
+        if level + 1 == depth:
+            surface.append(ambiguous)
+        elif len(ambiguous):
+            stack.extend((level + 1, ambiguous[s:s + per_step])
+                         for s in range(0, len(ambiguous), per_step))
+        meter.report(stack)
+    if suspects:
+        evaluated += settle_suspects()
+    if progress is not None:
+        progress(1.0)
+    return Subdivision(
+        codes=np.concatenate(surface) if surface else np.zeros(0, dtype=np.uint64),
+        interior={lvl: _unpack(np.concatenate(parts))
+                  for lvl, parts in sorted(interior_parts.items())},
+        evaluated=evaluated)
