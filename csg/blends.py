@@ -22,7 +22,7 @@ from typing import Any, Sequence
 import numpy as np
 
 import implicitvox as iv
-from implicitvox import Expr, x, y, z
+from implicitvox import Expr, _validate, x, y, z
 
 from .solid import Bounds, Solid
 
@@ -39,10 +39,9 @@ class SmoothBoolean(Solid):
     """Smooth union, intersection or difference of two solids with a fillet ``radius``."""
 
     def __init__(self, kind: str, a: Solid, b: Solid, radius: float):
-        from .primitives import _positive
         if kind not in ("union", "intersection", "difference"):
             raise ValueError(f"kind must be union, intersection or difference, got {kind!r}")
-        self.kind, self._children, self.radius = kind, (a, b), _positive(radius, "radius")
+        self.kind, self._children, self.radius = kind, (a, b), _validate.positive_number(radius, "radius")
 
     @property
     def children(self):
@@ -73,6 +72,11 @@ class SmoothBoolean(Solid):
 
     def __repr__(self) -> str:
         return f"smooth_{self.kind}({self._children[0]!r}, {self._children[1]!r}, {self.radius})"
+
+    def scene_node(self) -> dict:
+        """This node of a JSON scene (:mod:`csg.scene`)."""
+        return {"type": "smooth", "kind": self.kind, "radius": self.radius,
+                "children": [c.scene_node() for c in self.children]}
 
 
 def smooth_union(a: Solid, b: Solid, radius: float) -> Solid:
@@ -126,3 +130,10 @@ class Blobby(Solid):
 
     def __repr__(self) -> str:
         return f"Blobby({len(self.centers)} centres, threshold={self.threshold})"
+
+    def scene_node(self) -> dict:
+        """This node of a JSON scene (:mod:`csg.scene`)."""
+        return {"type": "blobby", "centers": self.centers.tolist(),
+                "radius": self.radius.tolist(), "threshold": self.threshold}
+
+

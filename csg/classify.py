@@ -7,7 +7,7 @@ similarity; any other subtree becomes one compiled implicit function). Each
 leaf classifies boxes as EMPTY, FULL or AMBIGUOUS:
 
 * a polyhedron exactly - AMBIGUOUS iff a triangle meets the closed box
-  (:class:`implicitvox.tribox.Triangles`), else FULL or EMPTY by the winding
+  (:class:`implicitvox.mesh.tribox.Triangles`), else FULL or EMPTY by the winding
   number at the box's centre;
 * boxes, convex polyhedra, half-spaces, spheres and ellipsoids (under any
   affine map), capped cylinders and cones (under similarities), tori (under
@@ -38,12 +38,14 @@ import numpy as np
 
 import implicitvox as iv
 from implicitvox.expr.shape import AMBIGUOUS, EMPTY, FULL
-from implicitvox.mesh.tribox import Triangles
 from implicitvox.mesh.crossings import RayWinding
-from implicitvox.mesh.pairs import _sorted_unique
+from implicitvox.mesh.pairs import sorted_unique
 from implicitvox.mesh.ranges import buckets, expand_boxes, gather
+from implicitvox.mesh.tribox import Triangles
+from implicitvox.octree.morton import CORNERS
 
-__all__ = ["exact_classifier", "MeshClassifier", "SETTLE_DEPTH"]
+__all__ = ["plan", "exact_classifier", "world_primitive", "similarity_scale", "MeshClassifier",
+           "SETTLE_DEPTH"]
 
 #: internal states: two or more exact children AMBIGUOUS (settled by subdivision), and
 #: an interval (not exact) AMBIGUOUS, which stays AMBIGUOUS through the booleans
@@ -52,21 +54,16 @@ UNKNOWN, MAYBE = 3, 4
 SETTLE_DEPTH = 2
 #: unknown boxes settled at once (each may have up to 4**SETTLE_DEPTH sub-boxes in play)
 SETTLE_CHUNK = 2048
-_HALF = np.array([[(k >> a) & 1 for a in range(3)] for k in range(8)], dtype=bool)
+_HALF = CORNERS.astype(bool)
+_BOOLEANS = ("union", "intersection", "difference", "complement")
 
 
-def _exact_types():
-    from .primitives import (Box, ConvexPolyhedron, Cylinder, Ellipsoid, HalfSpace, Polyhedron,
-                             Sphere, Torus)
-    return (Polyhedron, Box, ConvexPolyhedron, HalfSpace, Sphere, Ellipsoid, Cylinder, Torus)
-
-
-def _has_mesh(solid) -> bool:
+def _has_exact_leaf(solid) -> bool:
     """Whether a leaf of the tree has an exact test (a polyhedron or a max-norm primitive)."""
-    return isinstance(solid, _exact_types()) or any(_has_mesh(c) for c in solid.children)
+    return solid.exact or any(_has_exact_leaf(c) for c in solid.children)
 
 
-def _similarity_scale(m: np.ndarray) -> Optional[float]:
+def similarity_scale(m: np.ndarray) -> Optional[float]:
     """The scale of ``m`` if it is a rotation (or reflection) times a scale, else None."""
     gram = m.T @ m
     scale2 = gram[0, 0]
@@ -75,57 +72,13 @@ def _similarity_scale(m: np.ndarray) -> Optional[float]:
     return None
 
 
-def _linf_leaf(solid, matrix: np.ndarray):
-    """The leaf as a max-norm primitive in world space (implicitvox.linf), or None."""
-    from implicitvox import linf
-    from .primitives import Box, ConvexPolyhedron, Cylinder, Ellipsoid, HalfSpace, Sphere, Torus
-    m, t = matrix[:3, :3], matrix[:3, 3]
-    if isinstance(solid, Box):
-        lo, hi = (np.asarray(b) for b in solid.bounds)
-        corners = np.array([[(lo, hi)[(k >> a) & 1][a] for a in range(3)] for k in range(8)])
-        return linf.ConvexPolytope.from_points(corners @ m.T + t)
-    if isinstance(solid, ConvexPolyhedron):
-        if solid._points is not None:
-            return linf.ConvexPolytope.from_points(solid._points @ m.T + t)
-        return linf.ConvexPolytope.from_planes(solid.normals, solid.offsets).transformed(matrix)
-    if isinstance(solid, HalfSpace):
-        n = np.linalg.solve(m.T, solid.normal)          # M^-T n
-        return linf.HalfSpace(n, solid.offset + n @ t)
-    k = _similarity_scale(m)
-    if isinstance(solid, Sphere):
-        if k is not None:
-            return linf.Sphere(m @ solid.center + t, solid.r * k)
-        return linf.Ellipsoid.from_affine(m * solid.r, m @ solid.center + t)
-    if isinstance(solid, Ellipsoid):
-        return linf.Ellipsoid.from_affine(m @ np.diag(solid.radii), m @ solid.center + t)
-    if isinstance(solid, Cylinder):
-        if k is not None:
-            z0, _ = solid._z
-            return linf.Frustum(m @ np.array([0.0, 0.0, z0]) + t, m[:, 2], solid.h * k,
-                                solid.r1 * k, solid.r2 * k)
-    if isinstance(solid, Torus) and k is not None:
-        axis = m[:, 2] / np.linalg.norm(m[:, 2])
-        aligned = np.allclose(np.abs(axis), np.eye(3)[np.argmax(np.abs(axis))], rtol=0,
-                              atol=1e-12)
-        if aligned or solid.R > solid.r:           # tilted: exact for ring tori only
-            return linf.Torus(t, axis, solid.R * k, solid.r * k)
-    return None
-
-
-def world_linf(solid, matrix: Optional[np.ndarray] = None):
-    """A single (transformed) primitive as a world-space max-norm primitive, or None."""
-    from implicitvox import linf
-    from .primitives import Polyhedron
-    from .solid import Transformed
+def world_primitive(solid, matrix: Optional[np.ndarray] = None):
+    """A single (transformed) primitive as a world-space max-norm primitive
+    (:mod:`implicitvox.linf`), or None."""
     matrix = np.eye(4) if matrix is None else matrix
-    if isinstance(solid, Transformed):
-        return world_linf(solid.children[0], matrix @ solid.matrix)
-    if isinstance(solid, Polyhedron):
-        v = solid.vertices @ matrix[:3, :3].T + matrix[:3, 3]
-        return linf.TriangleMesh(v, solid.faces)
-    if isinstance(solid, _exact_types()):
-        return _linf_leaf(solid, matrix)
-    return None
+    while solid.operation == "transform":
+        solid, matrix = solid.children[0], matrix @ solid.matrix
+    return solid.world_linf(matrix) if solid.exact else None
 
 
 def _leaves(solid):
@@ -135,70 +88,67 @@ def _leaves(solid):
         yield from _leaves(c)
 
 
-def exact_classifier(solid, settle: bool = False
+def exact_classifier(tree_plan: Optional[tuple], settle: bool = False
                      ) -> Optional[Callable[[np.ndarray, np.ndarray], np.ndarray]]:
-    """The tree's box classifier, or None when no leaf has an exact test.
+    """The box classifier of a tree's :func:`plan`, or None when it has none.
 
     With ``settle``, boxes whose state is unknown (two exact surfaces meet
     them) are decided by subdivision (:func:`_settle`); without, they are
     AMBIGUOUS - right for an octant the voxelizer will subdivide anyway, and
     much cheaper. The voxelizer settles at the voxel level only.
     """
-    if not _has_mesh(solid):
+    if tree_plan is None:
         return None
-    cache = solid.__dict__.setdefault("_classifier_cache", {})
-    if "plan" not in cache:
-        cache["plan"] = _plan(solid, np.eye(4))
-    plan = cache["plan"]
 
     def classify(lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
         lo, hi = np.asarray(lo, dtype=float), np.asarray(hi, dtype=float)
-        state = _run(plan, lo, hi)
+        state = _run(tree_plan, lo, hi)
         unknown = np.flatnonzero(state == UNKNOWN) if settle else np.zeros(0, dtype=np.int64)
         for start in range(0, len(unknown), SETTLE_CHUNK):
             part = unknown[start:start + SETTLE_CHUNK]
-            state[part] = _settle(plan, lo[part], hi[part])
+            state[part] = _settle(tree_plan, lo[part], hi[part])
         state[(state == MAYBE) | (state == UNKNOWN)] = AMBIGUOUS
         return state
     return classify
 
 
+def _function(solid, matrix: np.ndarray) -> tuple:
+    identity = np.array_equal(matrix, np.eye(4))
+    return ("function", iv.compile(solid.expr if identity else solid.transform(matrix).expr))
+
+
+def plan(solid, matrix: Optional[np.ndarray] = None) -> Optional[tuple]:
+    """The tree flattened to world space for classification, or None when no
+    leaf has an exact test. Each node says what it is through its
+    ``operation`` (a boolean, ``"transform"``, or None), ``exact`` and
+    ``exact_leaf(matrix)``; nothing here names a primitive."""
+    if not _has_exact_leaf(solid):
+        return None
+    return _plan(solid, np.eye(4) if matrix is None else matrix)
+
+
 def _plan(solid, matrix: np.ndarray) -> tuple:
-    from .primitives import Polyhedron
-    from .solid import Complement, Difference, Intersection, Transformed, Union
-    if not _has_mesh(solid):
-        expr = Transformed(solid, matrix).expr if not np.array_equal(matrix, np.eye(4)) \
-            else solid.expr
-        return ("function", iv.compile(expr))
-    if isinstance(solid, Polyhedron):
-        v = solid.vertices @ matrix[:3, :3].T + matrix[:3, 3]
-        flip = np.linalg.det(matrix[:3, :3]) < 0      # mirrored: the winding sign flips
-        return ("mesh", MeshClassifier(v, solid.faces, flip))
-    if isinstance(solid, _exact_types()):
-        prim = _linf_leaf(solid, matrix)
-        if prim is not None:
-            return ("exact", prim)
-        return ("function", iv.compile(Transformed(solid, matrix).expr))
-    if isinstance(solid, Transformed):
+    if not _has_exact_leaf(solid):
+        return _function(solid, matrix)
+    if solid.operation == "transform":
         return _plan(solid.children[0], matrix @ solid.matrix)
-    if not isinstance(solid, (Union, Intersection, Difference, Complement)):
-        from .primitives import Polyhedron as _P
-        if any(isinstance(leaf, _P) for leaf in _leaves(solid)):
+    if solid.exact:
+        leaf = solid.exact_leaf(matrix)
+        return leaf if leaf is not None else _function(solid, matrix)
+    if solid.operation not in _BOOLEANS:
+        if any(leaf.needs_exact_test for leaf in _leaves(solid)):
             raise TypeError(f"{type(solid).__name__} with a polyhedron inside has no exact "
                             "test (only booleans and transforms combine them)")
         # another node (a blend, an extrusion): its own function, by intervals
-        return ("function", iv.compile(Transformed(solid, matrix).expr
-                                       if not np.array_equal(matrix, np.eye(4)) else solid.expr))
+        return _function(solid, matrix)
     kids = [_plan(c, matrix) for c in solid.children]
-    if isinstance(solid, Union):
+    if solid.operation == "union":
         return ("union", kids)
-    if isinstance(solid, Intersection):
+    if solid.operation == "intersection":
         return ("intersection", kids)
-    if isinstance(solid, Difference):
+    if solid.operation == "difference":
         return ("intersection", [kids[0]] + [("complement", k) for k in kids[1:]])
-    if isinstance(solid, Complement):
-        return ("complement", kids[0])
-    raise TypeError(f"{type(solid).__name__} with a polyhedron inside has no exact test")
+    return ("complement", kids[0])
 
 
 def _run(plan: tuple, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
@@ -326,6 +276,6 @@ class MeshClassifier:
         pb, pt = b[pair], self.cell_tris[index]
         # a triangle spanning several cells appears once per cell: keep one pair
         if len(pb):
-            pair = _sorted_unique(pb.astype(np.int64) * len(self.tris) + pt)
+            pair = sorted_unique(pb.astype(np.int64) * len(self.tris) + pt)
             pb, pt = pair // len(self.tris), pair % len(self.tris)
         return boxes[pb], pt

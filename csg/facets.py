@@ -36,6 +36,8 @@ import numpy as np
 import implicitvox as iv
 from implicitvox import Expr, x, y
 
+from .triangulate import triangulate
+
 __all__ = ["fragments", "circle_points", "sphere_points", "cylinder_points",
            "polygonal_radius", "extrusion_mesh"]
 
@@ -118,7 +120,6 @@ def extrusion_mesh(outline: np.ndarray, height: float, twist: float, scale: np.n
     Layer ``i`` is the outline turned by ``-twist i / slices`` degrees, then scaled by
     ``1 + (scale - 1) i / slices``, at ``z0 + height i / slices``.
     """
-    from .planar import _triangulate
     poly = np.asarray(outline, dtype=np.float64)
     area = 0.5 * np.sum(poly[:, 0] * np.roll(poly[:, 1], -1) - np.roll(poly[:, 0], -1) * poly[:, 1])
     if area < 0:
@@ -147,7 +148,7 @@ def extrusion_mesh(outline: np.ndarray, height: float, twist: float, scale: np.n
             else:
                 faces.append((a + j, a + j1, b + j))
                 faces.append((a + j1, b + j1, b + j))
-    cap = _triangulate(poly)
+    cap = triangulate(poly)
     faces += [(c, b_, a_) for a_, b_, c in cap]                       # bottom, facing down
     top = slices * k
     faces += [(top + a_, top + b_, top + c) for a_, b_, c in cap]     # top, facing up

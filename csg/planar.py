@@ -30,9 +30,11 @@ from typing import Any, Optional, Sequence
 import numpy as np
 
 import implicitvox as iv
-from implicitvox import Expr, x, y, z
+from implicitvox import Expr, _validate, x, y, z
 
+from .facets import polygonal_radius
 from .solid import Bounds, Solid, Union
+from .triangulate import triangulate
 
 __all__ = ["Circle", "Rectangle", "Polygon", "linear_extrude", "rotate_extrude",
            "LinearExtrude", "RotateExtrude"]
@@ -46,8 +48,7 @@ class Circle(Shape2D):
     """Disc of radius ``r`` about the origin."""
 
     def __init__(self, r: float = 1.0):
-        from .primitives import _positive
-        self.r = _positive(r, "r")
+        self.r = _validate.positive_number(r, "r")
 
     @property
     def expr(self) -> Expr:
@@ -59,6 +60,10 @@ class Circle(Shape2D):
 
     def __repr__(self) -> str:
         return f"Circle(r={self.r})"
+
+    def scene_node(self) -> dict:
+        """This node of a JSON scene (:mod:`csg.scene`)."""
+        return {"type": "circle", "r": self.r}
 
 
 class Rectangle(Shape2D):
@@ -87,32 +92,9 @@ class Rectangle(Shape2D):
     def __repr__(self) -> str:
         return f"Rectangle(size={self.size.tolist()}, center={self.centered})"
 
-
-def _triangulate(poly: np.ndarray) -> list[tuple[int, int, int]]:
-    """Ear clipping of a simple polygon (counter-clockwise), vertex indices."""
-    idx = list(range(len(poly)))
-    out = []
-    guard = 0
-    while len(idx) > 3 and guard < 10 * len(poly) ** 2:
-        guard += 1
-        n = len(idx)
-        for k in range(n):
-            a, b, c = idx[k - 1], idx[k], idx[(k + 1) % n]
-            pa, pb, pc = poly[a], poly[b], poly[c]
-            cross = (pb[0] - pa[0]) * (pc[1] - pa[1]) - (pb[1] - pa[1]) * (pc[0] - pa[0])
-            if cross <= 0:
-                continue
-            others = [poly[i] for i in idx if i not in (a, b, c)]
-            if any(_in_triangle(p, pa, pb, pc) for p in others):
-                continue
-            out.append((a, b, c))
-            idx.pop(k)
-            break
-        else:
-            raise ValueError("polygon is not simple (self-intersecting or degenerate)")
-    if len(idx) == 3:
-        out.append(tuple(idx))
-    return out
+    def scene_node(self) -> dict:
+        """This node of a JSON scene (:mod:`csg.scene`)."""
+        return {"type": "rectangle", "size": self.size.tolist(), "center": self.centered}
 
 
 def _convex(poly: np.ndarray) -> bool:
@@ -135,12 +117,6 @@ def _max_of_edges(poly: np.ndarray, order) -> Expr:
         n /= length
         edges.append(n[0] * (x - p[0]) + n[1] * (y - p[1]))
     return iv.max(*edges) if len(edges) > 1 else edges[0]
-
-
-def _in_triangle(p, a, b, c) -> bool:
-    def side(u, v, w):
-        return (v[0] - u[0]) * (w[1] - u[1]) - (v[1] - u[1]) * (w[0] - u[0])
-    return side(a, b, p) >= 0 and side(b, c, p) >= 0 and side(c, a, p) >= 0
 
 
 class Polygon(Shape2D):
@@ -174,7 +150,7 @@ class Polygon(Shape2D):
         if _convex(poly):                     # one piece: no inner edges to loosen intervals
             return _max_of_edges(poly, range(len(poly)))
         pieces = []
-        for a, b, c in _triangulate(poly):
+        for a, b, c in triangulate(poly):
             edges = []
             for p, q in ((poly[a], poly[b]), (poly[b], poly[c]), (poly[c], poly[a])):
                 n = np.array([q[1] - p[1], p[0] - q[0]])
@@ -199,6 +175,10 @@ class Polygon(Shape2D):
     def __repr__(self) -> str:
         return f"Polygon({len(self.points)} points, {len(self.paths)} paths)"
 
+    def scene_node(self) -> dict:
+        """This node of a JSON scene (:mod:`csg.scene`)."""
+        return {"type": "polygon", "points": self.points.tolist(), "paths": self.paths}
+
 
 def _as_2d(shape: Solid) -> Solid:
     if not isinstance(shape, Solid) or shape.dim != 2:
@@ -212,9 +192,8 @@ class LinearExtrude(Solid):
 
     def __init__(self, shape: Solid, height: float, twist: float = 0.0, scale: Any = 1.0,
                  center: bool = False):
-        from .primitives import _positive
         self._children = (_as_2d(shape),)
-        self.height = _positive(height, "height")
+        self.height = _validate.positive_number(height, "height")
         self.twist = float(twist)
         s = np.broadcast_to(np.asarray(scale, dtype=np.float64), (2,)).copy()
         if not np.all(s >= 0) or not np.all(np.isfinite(s)):
@@ -268,6 +247,12 @@ class LinearExtrude(Solid):
         return (f"linear_extrude({self._children[0]!r}, height={self.height}, "
                 f"twist={self.twist}, scale={self.scale_top.tolist()}, center={self.centered})")
 
+    def scene_node(self) -> dict:
+        """This node of a JSON scene (:mod:`csg.scene`)."""
+        return {"type": "linear_extrude", "height": self.height, "twist": self.twist,
+                "scale": self.scale_top.tolist(), "center": self.centered,
+                "child": self.children[0].scene_node()}
+
 
 class RotateExtrude(Solid):
     """See :func:`rotate_extrude`."""
@@ -296,7 +281,6 @@ class RotateExtrude(Solid):
         if self.sectors is None:
             rho = iv.hypot(x, y)
         else:                                 # OpenSCAD's facets: planar trapezoid sectors
-            from .facets import polygonal_radius
             rho = polygonal_radius(self.sectors, self.angle if abs(self.angle) < 360 else 360.0)
         radial = rho if b is None or b[1][0] > 0 else -rho     # a shape at x <= 0 sweeps too
         solid = shape.expr.remap(x=radial, y=z)
@@ -322,6 +306,14 @@ class RotateExtrude(Solid):
 
     def __repr__(self) -> str:
         return f"rotate_extrude({self._children[0]!r}, angle={self.angle})"
+
+    def scene_node(self) -> dict:
+        """This node of a JSON scene (:mod:`csg.scene`)."""
+        node = {"type": "rotate_extrude", "angle": self.angle,
+                "child": self.children[0].scene_node()}
+        if self.sectors is not None:
+            node["sectors"] = self.sectors
+        return node
 
 
 def linear_extrude(shape: Solid, height: float, twist: float = 0.0, scale: Any = 1.0,

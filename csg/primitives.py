@@ -21,37 +21,27 @@ from typing import Any, Optional, Sequence
 import numpy as np
 
 import implicitvox as iv
-from implicitvox import Expr, x, y, z
+from implicitvox import Expr, _validate, linf, x, y, z
+from implicitvox.mesh.inputs import as_triangles
+from implicitvox.octree.morton import CORNERS
 
-from .solid import Bounds, Solid, _vector
+from .classify import MeshClassifier, similarity_scale
+from .solid import Bounds, Solid, vector
 
 __all__ = ["Sphere", "Box", "Cylinder", "Torus", "Ellipsoid", "HalfSpace", "ConvexPolyhedron",
            "Polyhedron"]
 
 
-def _positive(value: Any, name: str) -> float:
-    try:
-        v = float(value)
-    except (TypeError, ValueError):
-        raise ValueError(f"{name} must be a number, got {value!r}") from None
-    if not (v > 0 and np.isfinite(v)):
-        raise ValueError(f"{name} must be positive and finite, got {value!r}")
-    return v
+_positive = _validate.positive_number
 
 
 def _nonneg(value: Any, name: str) -> float:
-    try:
-        v = float(value)
-    except (TypeError, ValueError):
-        raise ValueError(f"{name} must be a number, got {value!r}") from None
-    if not (v >= 0 and np.isfinite(v)):
-        raise ValueError(f"{name} must be >= 0 and finite, got {value!r}")
-    return v
+    return _validate.number_in(value, name, 0.0, float(np.finfo(np.float64).max))
 
 
 def _point(value: Any, name: str) -> np.ndarray:
     """3 finite floats (one number fills all three)."""
-    return _vector(value, name, planar=False, scalar=True)
+    return vector(value, name, planar=False, scalar=True)
 
 
 def _box(lo: Sequence[float], hi: Sequence[float]) -> Bounds:
@@ -74,8 +64,21 @@ class Sphere(Solid):
     def bounds(self) -> Bounds:
         return _box(self.center - self.r, self.center + self.r)
 
+    exact = True
+
+    def world_linf(self, matrix: np.ndarray) -> linf.Primitive:
+        m, t = matrix[:3, :3], matrix[:3, 3]
+        k = similarity_scale(m)
+        if k is not None:
+            return linf.Sphere(m @ self.center + t, self.r * k)
+        return linf.Ellipsoid.from_affine(m * self.r, m @ self.center + t)
+
     def __repr__(self) -> str:
         return f"Sphere(r={self.r}, center={self.center.tolist()})"
+
+    def scene_node(self) -> dict:
+        """This node of a JSON scene (:mod:`csg.scene`)."""
+        return {"type": "sphere", "r": self.r, "center": self.center.tolist()}
 
 
 class Box(Solid):
@@ -104,8 +107,19 @@ class Box(Solid):
     def bounds(self) -> Bounds:
         return _box(*self._lo_hi)
 
+    exact = True
+
+    def world_linf(self, matrix: np.ndarray) -> linf.Primitive:
+        lo, hi = self._lo_hi
+        corners = np.where(CORNERS.astype(bool), hi, lo)
+        return linf.ConvexPolytope.from_points(corners @ matrix[:3, :3].T + matrix[:3, 3])
+
     def __repr__(self) -> str:
         return f"Box(size={self.size.tolist()}, center={self.centered})"
+
+    def scene_node(self) -> dict:
+        """This node of a JSON scene (:mod:`csg.scene`)."""
+        return {"type": "box", "size": self.size.tolist(), "center": self.centered}
 
 
 class Cylinder(Solid):
@@ -148,8 +162,25 @@ class Cylinder(Solid):
         z0, z1 = self._z
         return _box((-r, -r, z0), (r, r, z1))
 
+    exact = True
+
+    def world_linf(self, matrix: np.ndarray) -> Optional[linf.Primitive]:
+        """Exact under similarities (a frustum); None under other maps."""
+        m, t = matrix[:3, :3], matrix[:3, 3]
+        k = similarity_scale(m)
+        if k is None:
+            return None
+        z0, _ = self._z
+        return linf.Frustum(m @ np.array([0.0, 0.0, z0]) + t, m[:, 2], self.h * k,
+                            self.r1 * k, self.r2 * k)
+
     def __repr__(self) -> str:
         return f"Cylinder(h={self.h}, r1={self.r1}, r2={self.r2}, center={self.centered})"
+
+    def scene_node(self) -> dict:
+        """This node of a JSON scene (:mod:`csg.scene`)."""
+        return {"type": "cylinder", "h": self.h, "r1": self.r1, "r2": self.r2,
+                "center": self.centered}
 
 
 class Torus(Solid):
@@ -167,8 +198,27 @@ class Torus(Solid):
         e = self.R + self.r
         return _box((-e, -e, -self.r), (e, e, self.r))
 
+    exact = True
+
+    def world_linf(self, matrix: np.ndarray) -> Optional[linf.Primitive]:
+        """Exact under similarities; turned off the axes, for ring tori only."""
+        m, t = matrix[:3, :3], matrix[:3, 3]
+        k = similarity_scale(m)
+        if k is None:
+            return None
+        axis = m[:, 2] / np.linalg.norm(m[:, 2])
+        aligned = np.allclose(np.abs(axis), np.eye(3)[np.argmax(np.abs(axis))], rtol=0,
+                              atol=1e-12)
+        if aligned or self.R > self.r:
+            return linf.Torus(t, axis, self.R * k, self.r * k)
+        return None
+
     def __repr__(self) -> str:
         return f"Torus(R={self.R}, r={self.r})"
+
+    def scene_node(self) -> dict:
+        """This node of a JSON scene (:mod:`csg.scene`)."""
+        return {"type": "torus", "R": self.R, "r": self.r}
 
 
 class Ellipsoid(Solid):
@@ -191,8 +241,19 @@ class Ellipsoid(Solid):
     def bounds(self) -> Bounds:
         return _box(self.center - self.radii, self.center + self.radii)
 
+    exact = True
+
+    def world_linf(self, matrix: np.ndarray) -> linf.Primitive:
+        m, t = matrix[:3, :3], matrix[:3, 3]
+        return linf.Ellipsoid.from_affine(m @ np.diag(self.radii), m @ self.center + t)
+
     def __repr__(self) -> str:
         return f"Ellipsoid(radii={self.radii.tolist()}, center={self.center.tolist()})"
+
+    def scene_node(self) -> dict:
+        """This node of a JSON scene (:mod:`csg.scene`)."""
+        return {"type": "ellipsoid", "radii": self.radii.tolist(),
+                "center": self.center.tolist()}
 
 
 class HalfSpace(Solid):
@@ -214,8 +275,19 @@ class HalfSpace(Solid):
     def bounds(self) -> Bounds:
         return None
 
+    exact = True
+
+    def world_linf(self, matrix: np.ndarray) -> linf.Primitive:
+        m, t = matrix[:3, :3], matrix[:3, 3]
+        n = np.linalg.solve(m.T, self.normal)          # M^-T n
+        return linf.HalfSpace(n, self.offset + n @ t)
+
     def __repr__(self) -> str:
         return f"HalfSpace(normal={self.normal.tolist()}, offset={self.offset})"
+
+    def scene_node(self) -> dict:
+        """This node of a JSON scene (:mod:`csg.scene`)."""
+        return {"type": "halfspace", "normal": self.normal.tolist(), "offset": self.offset}
 
 
 class ConvexPolyhedron(Solid):
@@ -237,13 +309,13 @@ class ConvexPolyhedron(Solid):
                 raise ValueError(f"the points span no volume (flat or degenerate): "
                                  f"{str(err).splitlines()[0]}") from None
             normals, offsets = hull.equations[:, :3], -hull.equations[:, 3]
-            self._points = pts[hull.vertices]
+            self.points = pts[hull.vertices]
         else:
             normals = np.asarray(planes[0], dtype=np.float64)
             offsets = np.asarray(planes[1], dtype=np.float64)
             if normals.ndim != 2 or normals.shape[1] != 3 or offsets.shape != (len(normals),):
                 raise ValueError("planes must be (normals (k, 3), offsets (k,))")
-            self._points = None
+            self.points = None
         length = np.linalg.norm(normals, axis=1)
         if np.any(length == 0) or not np.all(np.isfinite(normals)) or \
                 not np.all(np.isfinite(offsets)):
@@ -257,8 +329,8 @@ class ConvexPolyhedron(Solid):
 
     @property
     def bounds(self) -> Bounds:
-        if self._points is not None:
-            return _box(self._points.min(0), self._points.max(0))
+        if self.points is not None:
+            return _box(self.points.min(0), self.points.max(0))
         from scipy.optimize import linprog
         lo, hi = np.empty(3), np.empty(3)
         for a in range(3):
@@ -274,22 +346,33 @@ class ConvexPolyhedron(Solid):
         pad = 1e-9 * (np.abs(np.concatenate([lo, hi])).max() + 1)
         return _box(lo - pad, hi + pad)
 
+    exact = True
+
+    def world_linf(self, matrix: np.ndarray) -> linf.Primitive:
+        if self.points is not None:
+            return linf.ConvexPolytope.from_points(self.points @ matrix[:3, :3].T + matrix[:3, 3])
+        return linf.ConvexPolytope.from_planes(self.normals, self.offsets).transformed(matrix)
+
     def __repr__(self) -> str:
         return f"ConvexPolyhedron({len(self.normals)} planes)"
+
+    def scene_node(self) -> dict:
+        """This node of a JSON scene (:mod:`csg.scene`)."""
+        return {"type": "convex_polyhedron", "normals": self.normals.tolist(),
+                "offsets": self.offsets.tolist()}
 
 
 class Polyhedron(Solid):
     """Any closed triangle mesh (``vertices``, ``faces``, or a mesh file / PyVista mesh).
 
     Its geometry lives in an exact box classification (:mod:`csg.classify`:
-    the exact box-triangle test of :mod:`implicitvox.tribox`, and the
+    the exact box-triangle test of :mod:`implicitvox.mesh.tribox`, and the
     winding number for boxes off the surface). Its expression is only a
     bound - positive outside the bounding box, zero inside - which
     intervals read as "ask the exact test".
     """
 
     def __init__(self, vertices: Any, faces: Any = None):
-        from implicitvox.mesh.inputs import as_triangles
         mesh = vertices if faces is None else (vertices, faces)
         v, f = as_triangles(mesh)
         if not len(f):
@@ -309,5 +392,26 @@ class Polyhedron(Solid):
     def bounds(self) -> Bounds:
         return _box(self._lo, self._hi)
 
+    exact = True
+    #: its expression is only a bound: it must be classified exactly
+    needs_exact_test = True
+
+    def _world_vertices(self, matrix: np.ndarray) -> np.ndarray:
+        return self.vertices @ matrix[:3, :3].T + matrix[:3, 3]
+
+    def world_linf(self, matrix: np.ndarray) -> linf.Primitive:
+        return linf.TriangleMesh(self._world_vertices(matrix), self.faces)
+
+    def exact_leaf(self, matrix: np.ndarray) -> tuple[str, Any]:
+        flip = np.linalg.det(matrix[:3, :3]) < 0      # mirrored: the winding sign flips
+        return ("mesh", MeshClassifier(self._world_vertices(matrix), self.faces, flip))
+
     def __repr__(self) -> str:
         return f"Polyhedron({len(self.vertices)} vertices, {len(self.faces)} triangles)"
+
+    def scene_node(self) -> dict:
+        """This node of a JSON scene (:mod:`csg.scene`)."""
+        return {"type": "polyhedron", "vertices": self.vertices.tolist(),
+                "faces": self.faces.tolist()}
+
+

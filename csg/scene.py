@@ -69,69 +69,13 @@ class SceneError(ValueError):
 
 # -- writing -------------------------------------------------------------------------------
 def to_dict(solid: Solid) -> dict:
-    """The scene node of a solid."""
-    if isinstance(solid, Sphere):
-        return {"type": "sphere", "r": solid.r, "center": solid.center.tolist()}
-    if isinstance(solid, Box):
-        return {"type": "box", "size": solid.size.tolist(), "center": solid.centered}
-    if isinstance(solid, Cylinder):
-        return {"type": "cylinder", "h": solid.h, "r1": solid.r1, "r2": solid.r2,
-                "center": solid.centered}
-    if isinstance(solid, Torus):
-        return {"type": "torus", "R": solid.R, "r": solid.r}
-    if isinstance(solid, Ellipsoid):
-        return {"type": "ellipsoid", "radii": solid.radii.tolist(),
-                "center": solid.center.tolist()}
-    if isinstance(solid, HalfSpace):
-        return {"type": "halfspace", "normal": solid.normal.tolist(), "offset": solid.offset}
-    if isinstance(solid, ConvexPolyhedron):
-        return {"type": "convex_polyhedron", "normals": solid.normals.tolist(),
-                "offsets": solid.offsets.tolist()}
-    if isinstance(solid, Polyhedron):
-        return {"type": "polyhedron", "vertices": solid.vertices.tolist(),
-                "faces": solid.faces.tolist()}
-    if isinstance(solid, Circle):
-        return {"type": "circle", "r": solid.r}
-    if isinstance(solid, Rectangle):
-        return {"type": "rectangle", "size": solid.size.tolist(), "center": solid.centered}
-    if isinstance(solid, Polygon):
-        return {"type": "polygon", "points": solid.points.tolist(), "paths": solid.paths}
-    if isinstance(solid, (Union, Intersection, Difference)):
-        kind = {Union: "union", Intersection: "intersection", Difference: "difference"}
-        return {"type": kind[type(solid)], "children": [to_dict(c) for c in solid.children]}
-    if isinstance(solid, Complement):
-        return {"type": "complement", "child": to_dict(solid.children[0])}
-    if isinstance(solid, Transformed):
-        return {"type": "transform", "matrix": solid.matrix.tolist(),
-                "child": to_dict(solid.children[0])}
-    if isinstance(solid, LinearExtrude):
-        return {"type": "linear_extrude", "height": solid.height, "twist": solid.twist,
-                "scale": solid.scale_top.tolist(), "center": solid.centered,
-                "child": to_dict(solid.children[0])}
-    if isinstance(solid, RotateExtrude):
-        node = {"type": "rotate_extrude", "angle": solid.angle,
-                "child": to_dict(solid.children[0])}
-        if solid.sectors is not None:
-            node["sectors"] = solid.sectors
-        return node
-    if isinstance(solid, SmoothBoolean):
-        return {"type": "smooth", "kind": solid.kind, "radius": solid.radius,
-                "children": [to_dict(c) for c in solid.children]}
-    if isinstance(solid, Blobby):
-        return {"type": "blobby", "centers": solid.centers.tolist(),
-                "radius": solid.radius.tolist(), "threshold": solid.threshold}
-    if isinstance(solid, ExprSolid):
-        node = {"type": "expression", "expr": repr(solid.expr)}
-        if solid.bounds is not None:
-            node["bounds"] = [list(solid.bounds[0]), list(solid.bounds[1])]
-        return node
-    raise TypeError(f"{type(solid).__name__} has no JSON form")
+    """The scene node of a solid (each solid writes its own: ``Solid.scene_node``)."""
+    return solid.scene_node()
 
 
 def to_json(solid: Solid, indent: Any = None) -> str:
     """The solid as a JSON scene string."""
-    return json.dumps({"implicitvox_scene": 1, "root": to_dict(solid)}, indent=indent,
-                      allow_nan=False)
+    return solid.to_json(indent=indent)
 
 
 # -- reading -------------------------------------------------------------------------------

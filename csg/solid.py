@@ -19,21 +19,28 @@ Examples
 >>> bracket.bounds
 ((0.0, 0.0, 0.0), (4.0, 2.0, 1.0))
 >>> vox = bracket.voxelize(resolution=32)
->>> vox.resolution
-(32, 16, 8)
+>>> vox.resolution, vox.voxel_size[0] == vox.voxel_size[2]
+((32, 17, 9), True)
 """
 from __future__ import annotations
 
+import functools
+import json
 import math
 from typing import Any, Callable, Optional, Sequence
 
 import numpy as np
 
 import implicitvox as iv
-from implicitvox import Expr, x, y, z
+from implicitvox import Expr, _validate, x, y, z
+
+from .classify import exact_classifier, plan, world_primitive
 
 __all__ = ["Solid", "Union", "Intersection", "Difference", "Complement", "Transformed",
-           "ExprSolid", "Bounds", "rotation_matrix"]
+           "ExprSolid", "Bounds", "rotation_matrix", "vector", "SCENE_FORMAT"]
+
+#: the version of the JSON scene format (:mod:`csg.scene`)
+SCENE_FORMAT = 1
 
 Bounds = Optional[tuple[tuple[float, float, float], tuple[float, float, float]]]
 
@@ -43,6 +50,13 @@ class Solid:
 
     #: 3 for solids; 2 for planar regions (infinite prisms along z, for extrusions)
     dim = 3
+    #: what the exact classifier (:mod:`csg.classify`) reads of a node: its
+    #: operation ("union", "intersection", "difference", "complement",
+    #: "transform"; None for leaves and other nodes), whether it is a leaf with
+    #: an exact test, and whether it has nothing but one (a polyhedron)
+    operation: Optional[str] = None
+    exact = False
+    needs_exact_test = False
 
     # -- what subclasses provide -------------------------------------------------
     @property
@@ -82,7 +96,7 @@ class Solid:
 
     def translate(self, offset: Sequence[float]) -> "Solid":
         m = np.eye(4)
-        m[:3, 3] = _vector(offset, "offset")
+        m[:3, 3] = vector(offset, "offset")
         return Transformed(self, m)
 
     def rotate(self, axis: Any, degrees: float) -> "Solid":
@@ -101,7 +115,7 @@ class Solid:
 
     def mirror(self, normal: Sequence[float]) -> "Solid":
         """Reflect in the plane through the origin with this normal (OpenSCAD ``mirror``)."""
-        n = _vector(normal, "normal")
+        n = vector(normal, "normal")
         length = float(np.linalg.norm(n))
         if length == 0:
             raise ValueError("mirror normal must not be zero")
@@ -110,37 +124,49 @@ class Solid:
         m[:3, :3] -= 2.0 * np.outer(n, n)
         return Transformed(self, m)
 
+    # -- exact tests ----------------------------------------------------------------
+    def world_linf(self, matrix: np.ndarray) -> Any:
+        """This leaf under the affine ``matrix`` as a max-norm primitive
+        (:mod:`implicitvox.linf`), or None (the default: no exact form)."""
+        return None
+
+    def exact_leaf(self, matrix: np.ndarray) -> Optional[tuple[str, Any]]:
+        """This leaf's exact box test under ``matrix`` for :mod:`csg.classify`."""
+        prim = self.world_linf(matrix)
+        return None if prim is None else ("exact", prim)
+
+    @functools.cached_property
+    def exact_plan(self) -> Optional[tuple]:
+        """The tree flattened for exact classification (:func:`csg.classify.plan`),
+        or None when no leaf has an exact test; built once per solid."""
+        return plan(self)
+
     # -- voxelization --------------------------------------------------------------
     @property
     def classify_boxes(self) -> Optional[Callable[[np.ndarray, np.ndarray], np.ndarray]]:
         """Exact box test (:mod:`csg.classify`) if a leaf has one, else None."""
-        from .classify import exact_classifier
-        return exact_classifier(self)
+        return exact_classifier(self.exact_plan)
 
     @property
     def classify_voxels(self) -> Optional[Callable[[np.ndarray, np.ndarray], np.ndarray]]:
         """The exact test at the voxel level: as :attr:`classify_boxes`, and where two
         exact surfaces meet a box, decided by subdividing it (:mod:`csg.classify`)."""
-        from .classify import exact_classifier
-        return exact_classifier(self, settle=True)
+        return exact_classifier(self.exact_plan, settle=True)
 
-    def voxelize(self, resolution: Any = 256, bounds: Any = None, **options: Any) -> iv.Voxels:
-        """:func:`implicitvox.voxelize` this solid (bounds default to its own)."""
+    def voxelize(self, resolution: Any = None, **options: Any) -> iv.Voxels:
+        """:func:`implicitvox.voxelize` this solid, with the same arguments
+        (``bounds`` default to the solid's own, padded by the one rule)."""
         if self.dim != 3:
             raise ValueError("a 2D shape has no volume: extrude it first "
                              "(linear_extrude or rotate_extrude)")
-        if bounds is None:
-            bounds = self.bounds
-            if bounds is None:
-                raise ValueError("the solid is unbounded (a complement or half-space): "
-                                 "pass bounds")
-            bounds = _padded(bounds)
-        return iv.voxelize(self, bounds, resolution, **options)
+        if options.get("bounds") is None and self.bounds is None:
+            raise ValueError("the solid is unbounded (a complement or half-space): pass bounds")
+        return iv.voxelize(self, resolution, **options)
 
     def linf_distance(self, points: Any, weights: Any = None) -> np.ndarray:
         """Signed weighted max-norm distance (Varadhan §3; :mod:`implicitvox.linf`) for a
-        primitive with one - box, convex polyhedron, half-space, sphere, ellipsoid or
-        polyhedron (a triangle mesh) - under any transforms.
+        primitive with one - box, convex polyhedron, half-space, sphere, ellipsoid,
+        cylinder, torus or polyhedron (a triangle mesh) - under any transforms.
 
         Raises
         ------
@@ -148,28 +174,25 @@ class Solid:
             For other solids (booleans, blends, ...): their exact box test combines
             their leaves' tests instead (:attr:`classify_boxes`).
         """
-        from .classify import world_linf
-        prim = world_linf(self)
+        prim = world_primitive(self)
         if prim is None:
             raise TypeError(f"no max-norm distance for {type(self).__name__}: only single "
                             "primitives have one (booleans classify boxes leaf by leaf)")
         return prim.distance(points, weights)
 
-    def to_json(self, **kwargs: Any) -> str:
-        """The solid as a JSON scene (:mod:`csg.scene`)."""
-        from .scene import to_json
-        return to_json(self, **kwargs)
+    # -- scenes ------------------------------------------------------------------------
+    def scene_node(self) -> dict:
+        """This node of a JSON scene (:mod:`csg.scene`); each kind of solid writes its own."""
+        raise TypeError(f"{type(self).__name__} has no JSON form")
+
+    def to_json(self, indent: Any = None) -> str:
+        """The solid as a JSON scene (:mod:`csg.scene`, read back by :func:`csg.load_json`)."""
+        return json.dumps({"implicitvox_scene": SCENE_FORMAT, "root": self.scene_node()},
+                          indent=indent, allow_nan=False)
 
     def __repr__(self) -> str:
         args = ", ".join(repr(c) for c in self.children)
         return f"{type(self).__name__}({args})"
-
-
-def _padded(bounds) -> tuple:
-    """Bounds grown by 1% so the surface is not on the grid's edge (and flat ones have depth)."""
-    lo, hi = np.asarray(bounds[0], dtype=float), np.asarray(bounds[1], dtype=float)
-    pad = 0.01 * max(float((hi - lo).max()), 1e-300)
-    return tuple((lo - pad).tolist()), tuple((hi + pad).tolist())
 
 
 def _check_solid(other: Any, op: str) -> "Solid":
@@ -178,7 +201,7 @@ def _check_solid(other: Any, op: str) -> "Solid":
     return other
 
 
-def _vector(v: Any, name: str, *, planar: bool = True, scalar: bool = False) -> np.ndarray:
+def vector(v: Any, name: str, *, planar: bool = True, scalar: bool = False) -> np.ndarray:
     """3 finite floats, or a ``ValueError`` naming ``name``; with ``planar`` 2 numbers
     get z = 0 (transforms of 2D shapes), with ``scalar`` one number fills all three."""
     try:
@@ -200,7 +223,7 @@ def rotation_matrix(axis: Any, degrees: float) -> np.ndarray:
         if axis not in ("x", "y", "z"):
             raise ValueError(f"axis must be 'x', 'y', 'z' or a vector, got {axis!r}")
         axis = np.eye(3)["xyz".index(axis)]
-    u = _vector(axis, "axis")
+    u = vector(axis, "axis")
     norm = float(np.linalg.norm(u))
     if norm == 0:
         raise ValueError("rotation axis must not be zero")
@@ -242,11 +265,16 @@ class _NaryBoolean(Solid):
         return self._combine(*[c.expr for c in self._children]) if len(self._children) > 1 \
             else self._children[0].expr
 
+    def scene_node(self) -> dict:
+        """This node of a JSON scene (:mod:`csg.scene`)."""
+        return {"type": self.operation, "children": [c.scene_node() for c in self.children]}
+
 
 class Union(_NaryBoolean):
     """Points in any child: ``min`` of the functions."""
 
     _symbol, _name = "|", "a union"
+    operation = "union"
     _combine = staticmethod(iv.min)
 
     @property
@@ -262,6 +290,7 @@ class Intersection(_NaryBoolean):
     """Points in every child: ``max`` of the functions."""
 
     _symbol, _name = "&", "an intersection"
+    operation = "intersection"
     _combine = staticmethod(iv.max)
 
     @property
@@ -277,6 +306,8 @@ class Intersection(_NaryBoolean):
 
 class Difference(Solid):
     """The first solid minus the others: ``max(a, -b, ...)``."""
+
+    operation = "difference"
 
     def __init__(self, first: Solid, *others: Solid):
         self._children = (_check_solid(first, "-"),) + tuple(_check_solid(s, "-") for s in others)
@@ -296,9 +327,15 @@ class Difference(Solid):
     def bounds(self) -> Bounds:
         return self._children[0].bounds
 
+    def scene_node(self) -> dict:
+        """This node of a JSON scene (:mod:`csg.scene`)."""
+        return {"type": "difference", "children": [c.scene_node() for c in self.children]}
+
 
 class Complement(Solid):
     """Everything outside the solid: ``-f`` (unbounded)."""
+
+    operation = "complement"
 
     def __init__(self, solid: Solid):
         self._children = (_check_solid(solid, "~"),)
@@ -316,9 +353,15 @@ class Complement(Solid):
     def bounds(self) -> Bounds:
         return None
 
+    def scene_node(self) -> dict:
+        """This node of a JSON scene (:mod:`csg.scene`)."""
+        return {"type": "complement", "child": self.children[0].scene_node()}
+
 
 class Transformed(Solid):
     """A solid moved by an affine map ``p -> A p + t`` (its function at the pre-image)."""
+
+    operation = "transform"
 
     def __init__(self, solid: Solid, matrix: Any):
         m = np.array(matrix, dtype=np.float64)
@@ -374,6 +417,11 @@ class Transformed(Solid):
     def __repr__(self) -> str:
         return f"Transformed({self._children[0]!r}, matrix={self.matrix.tolist()})"
 
+    def scene_node(self) -> dict:
+        """This node of a JSON scene (:mod:`csg.scene`)."""
+        return {"type": "transform", "matrix": self.matrix.tolist(),
+                "child": self.children[0].scene_node()}
+
 
 class ExprSolid(Solid):
     """A raw implicitvox expression as a solid (negative inside)."""
@@ -381,8 +429,7 @@ class ExprSolid(Solid):
     def __init__(self, expr: Any, bounds: Bounds = None):
         self._expr = iv.wrap(expr)
         if bounds is not None:
-            from implicitvox.octree.grid import parse_bounds
-            bounds = parse_bounds(bounds)
+            bounds = _validate.bounds(bounds)
         self._bounds = bounds
 
     @property
@@ -395,3 +442,12 @@ class ExprSolid(Solid):
 
     def __repr__(self) -> str:
         return f"ExprSolid({self._expr!r:.80}, bounds={self._bounds})"
+
+    def scene_node(self) -> dict:
+        """This node of a JSON scene (:mod:`csg.scene`)."""
+        node = {"type": "expression", "expr": repr(self.expr)}
+        if self.bounds is not None:
+            node["bounds"] = [list(self.bounds[0]), list(self.bounds[1])]
+        return node
+
+

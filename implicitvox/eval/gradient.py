@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .point import evaluate_points
+from .point import apply_point
 from .tape import Tape
 
 __all__ = ["evaluate_gradients"]
@@ -36,11 +36,10 @@ def evaluate_gradients(tape: Tape, xs: np.ndarray, ys: np.ndarray, zs: np.ndarra
         for ins in tape.instructions:
             args = tuple(vals[a] for a in ins.args)
             arg_grads = tuple(grads[a] for a in ins.args)
+            out = apply_point(ins.op, args, ins.param)
             if ins.op.oracle:
-                out = ins.param.point(args, evaluate_points)
                 grads[ins.out] = ins.param.derivative(args, arg_grads, out, evaluate_gradients)
             else:
-                out = ins.op.point(args, ins.param)
                 grads[ins.out] = ins.op.derivative(args, arg_grads, out, ins.param)
             vals[ins.out] = out
     value = np.array(np.broadcast_to(vals[tape.output], (n,)), dtype=np.float64)

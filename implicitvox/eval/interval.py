@@ -37,7 +37,7 @@ def evaluate_intervals(tape: Tape, lo: tuple[np.ndarray, np.ndarray, np.ndarray]
         axis is innermost, where numpy's loops are fast).
     dtype : float64 or float32
         What the kernels compute in. float32 (only for tapes that
-        :func:`implicitvox.precision.interval_dtype` allows) rounds the boxes
+        :func:`implicitvox.octree.precision.interval_dtype` allows) rounds the boxes
         outward to float32 first (bounds already in float32 are taken as they
         are); the enclosures are returned as float64, unless ``native``.
     native : bool, default: False

@@ -12,7 +12,7 @@ proportional to the width squared, so on voxel-sized boxes it is much
 tighter. Both are enclosures; the voxelizer intersects them. ``f(c)`` is the
 interval of ``f`` over the degenerate box ``[c, c]`` (rounded outward), and
 the gradient enclosure comes from the interval chain rules of
-:mod:`implicitvox.interval_derivatives`; lanes where the mean value theorem
+:mod:`implicitvox.interval.derivatives`; lanes where the mean value theorem
 fails over the box (domain boundary, pole, branch cut, jump) keep the
 natural enclosure.
 

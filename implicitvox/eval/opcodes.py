@@ -4,7 +4,7 @@ Each :class:`Opcode` row carries
 
 * ``point(args, param)`` - numpy values from numpy argument values;
 * ``interval(los, his, param)`` - an outward-rounded enclosure
-  (:mod:`implicitvox.interval`); rows with ``domain=True`` also return a
+  (:mod:`implicitvox.interval.kernels`); rows with ``domain=True`` also return a
   boolean "empty" array (the argument lies wholly outside the domain);
 * ``derivative(vals, grads, out, param)`` - forward-mode rule: the gradient
   of the result (shape ``(3, n)``) from the argument values and gradients;
@@ -26,7 +26,7 @@ A new operation is one new row (libfive's ``opcode.hpp`` works the same way).
 
 Examples
 --------
->>> from implicitvox.opcodes import OPCODES
+>>> from implicitvox.eval.opcodes import OPCODES
 >>> OPCODES["sin"].arity
 1
 >>> sorted(name for name, op in OPCODES.items() if op.domain)

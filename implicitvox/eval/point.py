@@ -5,7 +5,7 @@ import numpy as np
 
 from .tape import Tape
 
-__all__ = ["evaluate_points"]
+__all__ = ["evaluate_points", "apply_point"]
 
 CHUNK = 1 << 16
 
@@ -35,7 +35,11 @@ def _evaluate(tape, xs, ys, zs):
         regs[c.register] = np.float64(c.value)
     with np.errstate(all="ignore"):
         for ins in tape.instructions:
-            args = tuple(regs[a] for a in ins.args)
-            regs[ins.out] = (ins.param.point(args, evaluate_points) if ins.op.oracle
-                             else ins.op.point(args, ins.param))
+            regs[ins.out] = apply_point(ins.op, tuple(regs[a] for a in ins.args), ins.param)
     return np.array(np.broadcast_to(regs[tape.output], (n,)), dtype=np.float64)
+
+
+def apply_point(op, args: tuple, param):
+    """One instruction's point values: the row's kernel, or its oracle driven
+    by this evaluator."""
+    return param.point(args, evaluate_points) if op.oracle else op.point(args, param)

@@ -5,7 +5,7 @@ Not on any hot path: one point at a time, at ``dps`` decimal digits.
 Examples
 --------
 >>> from implicitvox import x, y, sin
->>> from implicitvox.reference import mp_evaluate
+>>> from implicitvox.eval.reference import mp_evaluate
 >>> float(mp_evaluate(sin(x) * y, (1.0, 2.0, 0.0)))
 1.682941969615793
 """
@@ -18,7 +18,7 @@ import mpmath
 from .opcodes import OPCODES
 from .tape import compiled_oracle
 
-__all__ = ["mp_evaluate", "PERIODIC_LIMIT", "EXP_LIMIT"]
+__all__ = ["mp_evaluate", "apply_reference", "PERIODIC_LIMIT", "EXP_LIMIT"]
 
 #: periodic functions of larger arguments are not evaluated (mpmath would
 #: need pi to thousands of digits); the result is None ("not checked")
@@ -48,9 +48,15 @@ def mp_evaluate(expr: Any, point: Sequence[Any], dps: int = 60) -> Optional[Any]
                     v = None
                 elif node.op == "exp" and abs(args[0]) > EXP_LIMIT:
                     v = None
-                elif OPCODES[node.op].oracle:
-                    v = compiled_oracle(node.op, node.param).reference(args, mp_evaluate)
                 else:
-                    v = OPCODES[node.op].reference(args, node.param)
+                    v = apply_reference(OPCODES[node.op], args, node.param)
             vals[id(node)] = v
         return vals[id(expr)]
+
+
+def apply_reference(op, args: list, param) -> Optional[Any]:
+    """One operation's exact value at mpmath arguments (``None`` where undefined);
+    an oracle row's parameter may be the expression's or the tape's."""
+    if op.oracle:
+        return compiled_oracle(op.name, param).reference(args, mp_evaluate)
+    return op.reference(args, param)

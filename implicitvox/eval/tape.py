@@ -25,7 +25,7 @@ None of the evaluators walks the expression; all of them read this.
 Examples
 --------
 >>> from implicitvox import x, y, sin
->>> from implicitvox.tape import build_tape
+>>> from implicitvox.eval.tape import build_tape
 >>> tape = build_tape(sin(x) * sin(x) + y * 2.0)
 >>> [ins.op.name for ins in tape.instructions]
 ['sin', 'square', 'mulc', 'add']
@@ -145,7 +145,9 @@ def build_tape(expr: Expr) -> Tape:
             op, args, param = _with_constant_operand(op, args, param, values)
             op, args, param = _periodic_of_angle(op, args, param, values)
             op, args, param = _distance_of_squares(op, args, param, values, intern)
-            if all(values[a].kind == "const" for a in args):
+            if not op.oracle and all(values[a].kind == "const" for a in args):
+                # (an oracle on constants stays an instruction: folding it would need the
+                # evaluators, which read tapes)
                 c = _fold(op, [values[a] for a in args], param)
                 key = ("const",) + tuple(float(t).hex() for t in c)
                 idx = intern(key, _Value("const", const=c))
@@ -186,7 +188,7 @@ def _periodic_of_angle(op: Opcode, args: tuple[int, ...], param: Any,
                        values: list[_Value]) -> tuple[Opcode, tuple[int, ...], Any]:
     """``sin``/``cos`` of ``k * atan2(v, u) + c`` (``k`` an integer) become one
     ``periodic_angle`` node, tight across the branch cut
-    (:func:`implicitvox.interval.angle_interval`)."""
+    (:func:`implicitvox.interval.kernels.angle_interval`)."""
     if op.name not in ("sin", "cos"):
         return op, args, param
     node, k, c = values[args[0]], 1.0, 0.0

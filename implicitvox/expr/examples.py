@@ -1,11 +1,11 @@
 """Built-in example models (Stolte's Fig. 6 and Fig. 11 surfaces, and friends).
 
-Each example is a :class:`~implicitvox.shape.ExprShape` with bounds, so
+Each example is a :class:`~implicitvox.expr.shape.ExprShape` with bounds, so
 ``voxelize(example("sinsin34"), resolution=256)`` works as it is.
 
 Examples
 --------
->>> from implicitvox.examples import EXAMPLES, example
+>>> from implicitvox.expr.examples import EXAMPLES, example
 >>> sorted(EXAMPLES)[:3]
 ['blobby', 'flange', 'gear']
 >>> example("gear").bounds

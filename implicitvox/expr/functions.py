@@ -1,7 +1,7 @@
 """DSL functions: ``sqrt, square, abs, exp, log, sin, cos, tan, atan, atan2,
 asin, acos, hypot, min, max, floor, clip``.
 
-Each returns an :class:`~implicitvox.expr.Expr`. ``min`` and ``max`` take any
+Each returns an :class:`~implicitvox.expr.nodes.Expr`. ``min`` and ``max`` take any
 number of arguments (or one iterable) and fall back to Python's built-ins when
 no argument is an expression, so ``from implicitvox import *`` does not break
 ``min(1, 2)``; the same holds for ``abs``.

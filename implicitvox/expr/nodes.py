@@ -54,13 +54,13 @@ class Expr:
     """An immutable expression node.
 
     Build expressions from :data:`x`, :data:`y`, :data:`z`, numbers, the
-    operators ``+ - * / **`` and the functions in :mod:`implicitvox.functions`;
+    operators ``+ - * / **`` and the functions in :mod:`implicitvox.expr.functions`;
     do not call the constructor directly.
 
     Parameters
     ----------
     op : str
-        Opcode name (a row of :mod:`implicitvox.opcodes`).
+        Opcode name (a row of :mod:`implicitvox.eval.opcodes`).
     args : tuple of Expr
         Child expressions.
     param : object, optional

@@ -2,7 +2,7 @@
 
 A shape has
 
-* ``expr`` - the implicit function (an :class:`~implicitvox.expr.Expr`),
+* ``expr`` - the implicit function (an :class:`~implicitvox.expr.nodes.Expr`),
   negative inside;
 * ``bounds`` (optional) - ``((x0, y0, z0), (x1, y1, z1))`` holding the solid's
   surface, or ``None``;

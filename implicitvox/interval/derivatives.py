@@ -7,7 +7,7 @@ lanes where the mean value theorem does not hold over the box (a domain
 boundary, a pole, the ``atan2`` branch cut, a ``floor`` jump) or ``None``.
 
 The rules are the chain rule written with the outward-rounded kernels of
-:mod:`implicitvox.interval`, so they enclose every derivative value. For the
+:mod:`implicitvox.interval.kernels`, so they enclose every derivative value. For the
 Lipschitz but non-smooth ``abs``, ``min`` and ``max`` the rule returns the
 hull of the one-sided gradients (Clarke's generalized gradient), for which
 Lebourg's mean value theorem holds.

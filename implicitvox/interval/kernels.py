@@ -41,7 +41,7 @@ Infinities and NaN
 Examples
 --------
 >>> import numpy as np
->>> from implicitvox import interval as iv
+>>> from implicitvox.interval import kernels as iv
 >>> lo, hi = iv.i_sin(np.array([0.0]), np.array([3.0]))
 >>> float(lo[0]) < 0.0 < 1.0 == float(hi[0])
 True

@@ -31,14 +31,14 @@ the most negative, so endpoints never turn into NaN. When the sign of the
 result is known (``>= 0``), :func:`down_nonneg` and :func:`up_nonneg` do the
 same in fewer passes.
 
-The kernels in :mod:`implicitvox.interval` call these functions through the
+The kernels in :mod:`implicitvox.interval.kernels` call these functions through the
 module (``rounding.down``), so a test can switch rounding off and show that
 the enclosure then fails on crafted inputs.
 
 Examples
 --------
 >>> import numpy as np
->>> from implicitvox import rounding
+>>> from implicitvox.interval import rounding
 >>> a = np.array([0.1 + 0.7, 0.0, -np.inf, np.inf])
 >>> lo, hi = rounding.down(a), rounding.up(a)
 >>> bool(np.all(lo[:2] < a[:2]) and np.all(a[:2] < hi[:2]))
@@ -59,11 +59,11 @@ __all__ = ["down", "up", "down_nonneg", "up_nonneg", "limits", "TRANSCENDENTAL_U
 TRANSCENDENTAL_ULPS = 4
 #: floats after ``np.power`` (libm ``pow``) and ``np.hypot``.
 POW_ULPS = 2
-#: floats after sine from the half-angle tangent (:func:`implicitvox.interval.sin_values`):
+#: floats after sine from the half-angle tangent (:func:`implicitvox.interval.kernels.sin_values`):
 #: ``tan`` is off by ``T`` floats, which the formula passes on at most once (its relative
 #: condition number is at most 1), and its three rounded operations add 1.5.
 SIN_ULPS = TRANSCENDENTAL_ULPS + 2
-#: floats after cosine from tangents (:func:`implicitvox.interval.cos_values`): the sine
+#: floats after cosine from tangents (:func:`implicitvox.interval.kernels.cos_values`): the sine
 #: divided by ``tan x``, ``(T + 1.5) + T + 0.5``; where ``|tan x| <= 1`` the half-angle form
 #: is off by at most ``T + 2.5`` floats of 1, which is ``sqrt(2) (T + 2.5) <= 2 T + 2``
 #: floats of a cosine of at least ``1 / sqrt(2)`` (for ``T >= 3``).
@@ -72,7 +72,7 @@ COS_ULPS = 2 * TRANSCENDENTAL_ULPS + 2
 #: the spacing of floats at 1 (one ulp of 1.0)
 EPS = 2.0 ** -52
 #: per float type: (spacing at 1, smallest subnormal, largest finite); the
-#: interval kernels also run on float32 (:mod:`implicitvox.precision`)
+#: interval kernels also run on float32 (:mod:`implicitvox.eval.precision`)
 LIMITS = {np.dtype(np.float64): (EPS, 2.0 ** -1074, float(np.finfo(np.float64).max)),
           np.dtype(np.float32): (2.0 ** -23, 2.0 ** -149, float(np.finfo(np.float32).max))}
 _F64 = LIMITS[np.dtype(np.float64)]

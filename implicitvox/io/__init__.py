@@ -6,7 +6,7 @@
 """
 from ..octree.voxels import OUTPUTS
 from .files import load, save
-from .render import render, to_pyvista
+from .rendering import render, to_pyvista
 
 OUTPUTS.update(save=save, render=render, to_pyvista=to_pyvista)
 

@@ -24,7 +24,12 @@ import time
 import traceback
 from typing import Any, Optional, Sequence
 
+from .. import _validate
+from ..expr.examples import EXAMPLES, example
+from ..mesh.inputs import MESH_SUFFIXES
 from ..octree.subdivide import RECHECK
+from ..voxelizers.implicit import voxelize
+from ..voxelizers.mesh import voxelize_mesh
 
 __all__ = ["main", "ProgressBar", "load_model"]
 
@@ -117,7 +122,9 @@ def _parser() -> argparse.ArgumentParser:
     vox.add_argument("model", nargs="?",
                      help="a .py file that defines `shape`, or a mesh (.stl .ply .obj .vtk .vtp)")
     vox.add_argument("--example", help="a built-in example instead of a model file")
-    vox.add_argument("--resolution", type=int, default=256, help="voxels along the longest side")
+    size = vox.add_mutually_exclusive_group()
+    size.add_argument("--resolution", type=int, help="voxels along the longest side (default 256)")
+    size.add_argument("--voxel-size", type=float, metavar="H", help="the voxels' edge length")
     vox.add_argument("--bounds", type=float, nargs=6, metavar=("X0", "Y0", "Z0", "X1", "Y1", "Z1"))
     vox.add_argument("--interior", action="store_true", help="also find interior octants")
     vox.add_argument("--facets", choices=["true", "openscad"], default="true",
@@ -137,22 +144,7 @@ def _parser() -> argparse.ArgumentParser:
     return parser
 
 
-def _check_writable(path: Optional[str], what: str) -> None:
-    if path is None:
-        return
-    folder = os.path.dirname(os.path.abspath(path)) or "."
-    if not os.path.isdir(folder) or not os.access(folder, os.W_OK):
-        raise ModelError(f"cannot write {what} {path}: folder {folder} does not exist "
-                         "or is not writable")
-
-
 def _voxelize(args: argparse.Namespace) -> int:
-    from ..expr.examples import example
-    from ..voxelizers.implicit import voxelize
-
-    from ..mesh.inputs import MESH_SUFFIXES
-    from ..voxelizers.mesh import voxelize_mesh
-
     if (args.model is None) == (args.example is None):
         raise ModelError("give a model file or --example NAME (one of them)")
     is_mesh = args.model is not None and args.model.lower().endswith(MESH_SUFFIXES)
@@ -161,25 +153,27 @@ def _voxelize(args: argparse.Namespace) -> int:
         shape = example(args.example) if args.example else \
             load_model(args.model, **({"facets": args.facets} if not
                                       args.model.endswith(".py") else {}))
-    _check_writable(args.out, "--out")
-    _check_writable(args.render, "--render")
+    for path, flag in ((args.out, "--out"), (args.render, "--render")):
+        if path is not None:
+            _validate.writable_path(path, flag)
     bounds = None
     if args.bounds:
         bounds = (tuple(args.bounds[:3]), tuple(args.bounds[3:]))
     bar = None if args.quiet else ProgressBar()
-    max_memory = None if args.max_memory is None else int(args.max_memory * 2**30)
+    max_memory = None if args.max_memory is None else \
+        _validate.max_memory(_validate.positive_number(args.max_memory, "--max-memory") * 2**30,
+                             "--max-memory (bytes)")
     if is_mesh:
         if args.normals or args.mean_value or args.subvoxel:
             raise ModelError("--normals, --mean-value and --subvoxel apply to implicit models, "
                              "not to meshes")
-        vox = voxelize_mesh(args.model, args.resolution, bounds, solid=args.interior,
-                            progress=bar, max_memory=max_memory)
+        vox = voxelize_mesh(args.model, args.resolution, bounds=bounds,
+                            voxel_size=args.voxel_size, interior=args.interior, progress=bar,
+                            max_memory=max_memory)
     else:
-        if bounds is None and getattr(shape, "bounds", None) is not None:
-            bounds = _padded(shape.bounds)
-        vox = voxelize(shape, bounds, args.resolution, interior=args.interior,
-                       normals=args.normals or bool(args.render), progress=bar,
-                       max_memory=max_memory, mean_value=args.mean_value,
+        vox = voxelize(shape, args.resolution, bounds=bounds, voxel_size=args.voxel_size,
+                       interior=args.interior, normals=args.normals or bool(args.render),
+                       progress=bar, max_memory=max_memory, mean_value=args.mean_value,
                        subvoxel=args.subvoxel, recheck=args.recheck)
     if bar:
         bar.close()
@@ -197,19 +191,11 @@ def _voxelize(args: argparse.Namespace) -> int:
     return 0
 
 
-def _padded(bounds: Any) -> Any:
-    """A shape's own bounds grown by 1% (its surface off the grid's edge)."""
-    lo, hi = bounds
-    pad = 0.01 * max(b - a for a, b in zip(lo, hi))
-    return tuple(a - pad for a in lo), tuple(b + pad for b in hi)
-
-
 def main(argv: Optional[Sequence[str]] = None) -> int:
     """Entry point; returns the exit status (2 for bad input)."""
     args = _parser().parse_args(argv)
     try:
         if args.command == "examples":
-            from ..expr.examples import EXAMPLES
             for name, (description, _) in EXAMPLES.items():
                 print(f"{name:<14}{description}")
             return 0

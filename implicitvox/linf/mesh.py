@@ -12,14 +12,14 @@ For each query point:
    (:func:`~implicitvox.linf.polytope.triangle_distance`), and the minimum.
 
 The sign comes from the exact winding number of a closed mesh
-(:class:`~implicitvox.crossings.RayWinding`); open meshes give unsigned
+(:class:`~implicitvox.mesh.crossings.RayWinding`); open meshes give unsigned
 distances.
 
 Examples
 --------
 >>> import numpy as np
 >>> import pyvista as pv
->>> from implicitvox.mesh_input import as_triangles
+>>> from implicitvox.mesh.inputs import as_triangles
 >>> mesh = TriangleMesh(*as_triangles(pv.Cube()))
 >>> mesh.distance(np.array([[2.0, 0.0, 0.0], [0.0, 0.0, 0.1]])).round(12).tolist()
 [1.5, -0.4]

@@ -4,7 +4,7 @@ Voxels the surface does not meet fall into 6-connected components
 (:func:`scipy.ndimage.label`); two face-neighbours that both miss the surface
 are on the same side of it, so each component is wholly inside or wholly
 outside a closed mesh. The generalized winding number
-(:mod:`implicitvox.winding`) at a few voxel centres of each component says
+(:mod:`implicitvox.mesh.winding`) at a few voxel centres of each component says
 which: inside iff it exceeds 1/2. Only a handful of points per component are
 evaluated, never one per voxel.
 
@@ -16,7 +16,7 @@ disagree. Such a component is filled by the majority of its samples and a
 :class:`UserWarning` says the mesh is not closed at this resolution.
 
 The interior is returned as the largest aligned octants it fills (per
-octree level), the form :class:`~implicitvox.voxels.Voxels` stores.
+octree level), the form :class:`~implicitvox.octree.voxels.Voxels` stores.
 """
 from __future__ import annotations
 

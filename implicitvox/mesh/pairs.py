@@ -9,7 +9,7 @@ level in chunks of bounded size:
    (exact float comparisons against the children's edges);
 2. a child whose box holds the triangle's whole bounding box meets it (no
    test needed); the others go through the exact box-triangle test of
-   :mod:`implicitvox.tribox`;
+   :mod:`implicitvox.mesh.tribox`;
 3. at the voxel level, the voxels met by any pair are the output.
 
 Both filters are exact, so the result is exactly the set of voxels whose
@@ -20,8 +20,8 @@ same float box at every level and in every test.
 Examples
 --------
 >>> import numpy as np
->>> from implicitvox.grid import Grid
->>> from implicitvox.tribox import Triangles
+>>> from implicitvox.octree.grid import Grid
+>>> from implicitvox.mesh.tribox import Triangles
 >>> tri = Triangles(np.array([[[0.1, 0.1, 0.5], [0.9, 0.1, 0.5], [0.1, 0.9, 0.5]]]))
 >>> codes = surface_codes(tri, Grid.from_bounds(((0, 0, 0), (1, 1, 1)), 4))
 >>> len(codes)   # z = 0.5 is the edge between voxel layers 1 and 2: 13 voxels in each
@@ -38,7 +38,7 @@ from ..octree.grid import Grid
 from .ranges import expand_boxes
 from .tribox import Triangles, vertex_in_box
 
-__all__ = ["surface_codes", "CHUNK"]
+__all__ = ["surface_codes", "sorted_unique", "CHUNK"]
 
 #: (node, triangle) pairs per chunk
 CHUNK = 1 << 16
@@ -197,7 +197,7 @@ def surface_codes(tris: Triangles, grid: Grid,
         holds[test] = tris.meet_boxes(tri[test], lo[test], hi[test])
         weight = len(nodes) / total
         if level == grid.depth:
-            found.append(_sorted_unique(morton.encode(nodes[holds])))
+            found.append(sorted_unique(morton.encode(nodes[holds])))
             done += weight
         else:
             _push(stack, level, nodes[holds], tri[holds], weight)
@@ -216,10 +216,10 @@ def surface_codes(tris: Triangles, grid: Grid,
             progress(min(done, 1.0))
     if not found:
         return np.zeros(0, dtype=np.uint64)
-    return _sorted_unique(np.concatenate(found))
+    return sorted_unique(np.concatenate(found))
 
 
-def _sorted_unique(codes: np.ndarray) -> np.ndarray:
+def sorted_unique(codes: np.ndarray) -> np.ndarray:
     """``np.unique`` by sorting (numpy's hash-based unique is slower on uint64 codes)."""
     codes.sort()
     keep = np.empty(len(codes), dtype=bool)

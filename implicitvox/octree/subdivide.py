@@ -19,7 +19,7 @@ chunk is an independent set of subtrees (the unit a parallel driver hands
 out; Stolte §5.2). Octants travel as Morton codes (a child is ``parent << 3
 | slot``), so the surface voxels come out ready for the pointer octree, and
 the interval evaluation runs in float32 where
-:func:`implicitvox.precision.interval_dtype` allows it (about 3 times
+:func:`implicitvox.octree.precision.interval_dtype` allows it (about 3 times
 faster, still rounded outward).
 """
 from __future__ import annotations
@@ -82,11 +82,11 @@ def classify(func: Function, grid: Grid, level: int, coords: np.ndarray,
     """States (int8) of octants ``coords`` at ``level``: EMPTY, FULL or AMBIGUOUS.
 
     The natural interval extension decides first; octants it leaves
-    AMBIGUOUS get the mean value form (:mod:`implicitvox.mean_value`) when
+    AMBIGUOUS get the mean value form (:mod:`implicitvox.eval.mean_value`) when
     ``mean_value``, then the shape's exact test. A box's state depends on the
     box alone, not on the level or the run, so ``Voxels.refine`` matches a
     direct voxelization: the natural extension runs in the float type that
-    :func:`implicitvox.precision.interval_dtype` picks for the box size
+    :func:`implicitvox.octree.precision.interval_dtype` picks for the box size
     (``dtype`` None), or in ``dtype``.
     """
     lo, hi = grid.octant_boxes(level, coords)
@@ -118,7 +118,7 @@ def _tighten(func: Function, lo, hi, flo: np.ndarray, fhi: np.ndarray, state: np
 
 _BROADCAST = [(1, 1, 2, -1), (1, 2, 1, -1), (2, 1, 1, -1)]
 
-# Octants on the stack are Morton codes (uint64, :mod:`implicitvox.morton`): a
+# Octants on the stack are Morton codes (uint64, :mod:`implicitvox.octree.morton`): a
 # child is ``parent << 3 | slot``, selecting kept children gathers one integer
 # per octant, and the surface voxels come out ready for the octree.
 _SLOTS = np.arange(8, dtype=np.uint64)
@@ -144,7 +144,7 @@ def _child_boxes(grid: Grid, level: int, parents: tuple[np.ndarray, ...], single
     ``z (2, 1, 1, m)``; the (2, 2, 2, m) result reshapes to ``(8, m)`` in
     child order ``x + 2y + 4z``. Children past the grid get degenerate boxes
     on its edge (they are dropped after). ``single``: float32 bounds rounded
-    outward (the same values :func:`implicitvox.precision.outward_float32`
+    outward (the same values :func:`implicitvox.interval.float32.outward_float32`
     gives the float64 ones). Looked up in :func:`_child_edges` (one gather
     per axis and end) up to grids of ``_EDGE_TABLE_LIMIT`` voxels a side."""
     lo, hi = [], []
@@ -369,7 +369,7 @@ def subdivide(func: Function, grid: Grid, *, start: Optional[tuple[int, np.ndarr
         The shape's exact box test, applied to interval-AMBIGUOUS octants.
     exact_voxels : callable, optional
         Its form for the target depth (default: ``exact``), which must decide
-        every box (see :func:`implicitvox.shape.voxel_classifier`).
+        every box (see :func:`implicitvox.expr.shape.voxel_classifier`).
     progress : callable, optional
         Called with the estimated share of work done, in [0, 1].
     chunk : int

@@ -27,7 +27,7 @@ __all__ = ["Voxels", "VoxelSource", "DEFAULT_DENSE_LIMIT", "OUTPUTS"]
 #: default memory limit of dense outputs (bytes)
 DEFAULT_DENSE_LIMIT = 4 << 30
 #: the output functions behind :meth:`Voxels.save`, :meth:`Voxels.render` and
-#: :meth:`Voxels.to_pyvista`, registered by :mod:`implicitvox.io` (the layer
+#: :meth:`Voxels.to_pyvista`, registered by :mod:`implicitvox.io.files` (the layer
 #: above this one) when it is imported
 OUTPUTS: dict[str, Callable[..., Any]] = {}
 
@@ -198,11 +198,11 @@ class Voxels:
     def to_pyvista(self, kind: str = "points"):
         """PyVista object: ``"points"`` (PolyData of centres, with normals) or
         ``"cubes"`` (UnstructuredGrid of voxel cells); see
-        :func:`implicitvox.io.render.to_pyvista`."""
+        :func:`implicitvox.io.rendering.to_pyvista`."""
         return _output("to_pyvista")(self, kind)
 
     def render(self, path: str, **kwargs: Any) -> str:
-        """Render off screen to a PNG (see :func:`implicitvox.io.render.render`)."""
+        """Render off screen to a PNG (see :func:`implicitvox.io.rendering.render`)."""
         return _output("render")(self, path, **kwargs)
 
     def save(self, path: str) -> str:
@@ -219,5 +219,5 @@ def _output(name: str) -> Callable[..., Any]:
     try:
         return OUTPUTS[name]
     except KeyError:
-        raise RuntimeError(f"Voxels.{name} is provided by implicitvox.io, which registers it "
+        raise RuntimeError(f"Voxels.{name} is provided by implicitvox.io.files, which registers it "
                            "when imported: import implicitvox") from None

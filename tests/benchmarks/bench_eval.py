@@ -7,7 +7,7 @@ Prints, for each model, the point cost, the interval cost, and their ratio
 in the same run, the cost of the equivalent plain numpy expression. The
 ``instr`` column is the tape's length after its rewrites: each sphere
 ``sqrt((x-a)**2 + (y-b)**2 + (z-c)**2) - r`` is one fused ``distance`` and one
-``addc`` (see :mod:`implicitvox.tape`).
+``addc`` (see :mod:`implicitvox.eval.tape`).
 """
 from __future__ import annotations
 

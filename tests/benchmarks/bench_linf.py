@@ -20,7 +20,7 @@ from implicitvox import linf
 from implicitvox.mesh.inputs import as_triangles
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2]))     # the repository root
-from tests.mesh_helpers import BUNNY  # noqa: E402
+from tests.support.mesh_helpers import BUNNY  # noqa: E402
 
 N = 100_000
 

@@ -26,7 +26,7 @@ import implicitvox as ivx
 from implicitvox.mesh.inputs import as_triangles
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2]))     # the repository root
-from tests.mesh_helpers import BUNNY, sample_surface  # noqa: E402
+from tests.support.mesh_helpers import BUNNY, sample_surface  # noqa: E402
 
 
 def best_of(repeat: int, run):

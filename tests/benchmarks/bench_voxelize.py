@@ -16,7 +16,7 @@ Prints, single process:
    ``mean_value=True``, ``subvoxel=1`` and ``mean_value=True, subvoxel=2``.
 
 The interval evaluation runs in float32 for these models at every level
-(:func:`implicitvox.precision.interval_dtype`; the "fp" column).
+(:func:`implicitvox.octree.precision.interval_dtype`; the "fp" column).
 """
 from __future__ import annotations
 

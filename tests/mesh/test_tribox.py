@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from implicitvox.mesh.tribox import Triangles
-from tests.clip_oracle import triangle_meets_box
+from tests.support.clip_oracle import triangle_meets_box
 
 
 def _check(tri, lo, hi):

@@ -9,7 +9,7 @@ import pyvista as pv
 
 import implicitvox as ivx
 from implicitvox.mesh.inputs import as_triangles
-from tests.mesh_helpers import (BUNNY, misses, neighbours_outside, oracle_meets,
+from tests.support.mesh_helpers import (BUNNY, misses, neighbours_outside, oracle_meets,
                                 sample_surface)
 
 needs_bunny = pytest.mark.skipif(
@@ -73,7 +73,7 @@ def test_small_meshes_equal_the_oracle_everywhere(name):
         v = np.array([[0.1, 0.2, 0.3], [0.9, 0.8, 0.7], [0.5, 0.5, 0.5], [0.25, 0.25, 0.25]])
         f = np.array([[0, 1, 2], [3, 3, 3], [0, 0, 1], [0, 1, 1]])
         bounds, res = ((0, 0, 0), (1, 1, 1)), 8
-    vox = ivx.voxelize_mesh((v, f), res, bounds)
+    vox = ivx.voxelize_mesh((v, f), res, bounds=bounds)
     every = _all_voxels(vox.resolution)
     assert vox.contains(every).tolist() == oracle_meets(v[f], vox.grid, every).tolist()
 
@@ -104,9 +104,9 @@ def test_refine_equals_direct():
     mesh = pv.examples.load_nut()
     mesh = mesh.translate(-np.array(mesh.center)).scale(1.5 / max(mesh.bounds_size))
     bounds = ((-1, -1, -1), (1, 1, 1))
-    coarse = ivx.voxelize_mesh(mesh, 32, bounds)
+    coarse = ivx.voxelize_mesh(mesh, 32, bounds=bounds)
     fine = coarse.refine(1)
-    direct = ivx.voxelize_mesh(mesh, 64, bounds)
+    direct = ivx.voxelize_mesh(mesh, 64, bounds=bounds)
     assert fine.grid == direct.grid          # dyadic voxel sizes: the same edges
     assert fine.count > 4 * coarse.count > 0
     assert np.array_equal(fine.coords(), direct.coords())
@@ -114,7 +114,7 @@ def test_refine_equals_direct():
 
 def test_solid_brackets_the_volume():
     mesh = pv.Sphere(radius=1.0, theta_resolution=40, phi_resolution=40)
-    vox = ivx.voxelize_mesh(mesh, 64, solid=True)
+    vox = ivx.voxelize_mesh(mesh, 64, interior=True)
     cell = float(np.prod(vox.voxel_size))
     volume = mesh.volume
     assert vox.interior_count * cell <= volume <= (vox.interior_count + vox.count) * cell
@@ -123,10 +123,11 @@ def test_solid_brackets_the_volume():
 
 
 def test_solid_of_an_open_mesh_warns():
-    """A sphere with a cap cut off: inside and outside are one region of voxels."""
+    """A sphere with a cap cut off: inside and outside are one region of voxels
+    (the grid reaches past the hole, so the region joins them through it)."""
     mesh = pv.Sphere(radius=1.0).clip("z", origin=(0, 0, 0.6))
     with pytest.warns(UserWarning, match="not closed"):
-        ivx.voxelize_mesh(mesh, 32, solid=True)
+        ivx.voxelize_mesh(mesh, 32, bounds=((-1.2,) * 3, (1.2,) * 3), interior=True)
 
 
 def test_solid_of_two_disjoint_closed_meshes():
@@ -134,7 +135,7 @@ def test_solid_of_two_disjoint_closed_meshes():
     b = pv.Cube(center=(3, 0, 0))
     with warnings.catch_warnings():
         warnings.simplefilter("error")
-        vox = ivx.voxelize_mesh(a + b, 64, solid=True)
+        vox = ivx.voxelize_mesh(a + b, 64, interior=True)
     assert vox.interior_count > 0
     d = vox.to_dense()
     mid = vox.grid.voxels_holding(np.array([[1.5, 0.0, 0.0]]))[0][0]
@@ -146,7 +147,7 @@ def test_progress_and_memory_budget():
     ivx.voxelize_mesh(pv.Sphere(), 64, progress=seen.append)
     assert seen and seen[-1] == pytest.approx(1.0) and seen == sorted(seen)
     with pytest.raises(MemoryError, match="budget"):
-        ivx.voxelize_mesh(pv.Sphere(), 4096, solid=True, max_memory=1 << 20)
+        ivx.voxelize_mesh(pv.Sphere(), 4096, interior=True, max_memory=1 << 20)
 
 
 @pytest.mark.parametrize("mesh, error, match", [

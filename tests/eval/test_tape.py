@@ -7,7 +7,7 @@ import numpy as np
 import implicitvox as ivx
 from implicitvox import x, y, z
 from implicitvox.eval.tape import build_tape
-from tests.reference import contains
+from tests.support.reference import contains
 
 
 def names(tape):

@@ -14,7 +14,7 @@ import implicitvox as ivx
 from implicitvox import hypot, max, min, sqrt, x, y, z
 from implicitvox.expr.examples import blobby, gear, lobed_plate, replicated_torus, sinsin
 from implicitvox.octree.grid import Grid
-from tests.surface import corner_sign_voxels, found, surface_brackets
+from tests.support.surface import corner_sign_voxels, found, surface_brackets
 
 RES = 64
 N_POINTS = 20_000
@@ -78,7 +78,7 @@ MODELS = {
 
 def _run(name, **options):
     expr, bounds, inside = MODELS[name]()
-    vox = ivx.voxelize(expr, bounds, RES, **options)
+    vox = ivx.voxelize(expr, RES, bounds=bounds, **options)
     func = ivx.compile(expr)
     step = float(np.max(vox.voxel_size))
     a, b = surface_brackets(func, bounds, step, N_POINTS, np.random.default_rng(11), inside)

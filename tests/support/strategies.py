@@ -40,8 +40,8 @@ def param_for(draw, name: str):
     if name in ("addc", "rsubc", "mulc"):
         return draw(anywhere)
     if name in ("repeat", "repeat_polar"):
-        from implicitvox.eval.opcodes import prepared
-        return prepared(name, draw(sweep_param(name)))
+        from implicitvox.eval.tape import compiled_oracle
+        return compiled_oracle(name, draw(sweep_param(name)))
     if name == "periodic_angle":
         return (draw(st.sampled_from(["sin", "cos"])), float(draw(st.integers(-9, 9))),
                 draw(st.floats(-3.0, 3.0)))

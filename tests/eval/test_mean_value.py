@@ -11,8 +11,8 @@ from hypothesis import strategies as st
 import implicitvox as ivx
 from implicitvox.eval.mean_value import evaluate_interval_gradients, mean_value_enclosure
 from implicitvox.eval.opcodes import OPCODES
-from tests.reference import contains, mp_value
-from tests.strategies import expression
+from tests.support.reference import contains, mp_value
+from tests.support.strategies import expression
 
 
 def columns(lo, hi):
@@ -65,7 +65,7 @@ def test_gradient_intervals_hold_point_gradients(expr, point, width):
 
 
 def test_every_opcode_has_an_interval_derivative():
-    assert all(op.interval_derivative is not None for op in OPCODES.values())
+    assert all(op.interval_derivative is not None or op.oracle for op in OPCODES.values())
 
 
 def test_mean_value_is_tighter_on_voxel_sized_boxes():

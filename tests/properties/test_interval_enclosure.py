@@ -16,8 +16,11 @@ from hypothesis import strategies as st
 
 import implicitvox as ivx
 from implicitvox.eval.opcodes import OPCODES
-from tests.reference import DPS, contains, iv_interval, mp_value
-from tests.strategies import (BINARY, box3, elements_for, expression, interval, param_for,
+from implicitvox.eval.reference import apply_reference
+from implicitvox.eval.interval import apply_op
+from implicitvox.eval.point import apply_point
+from tests.support.reference import DPS, contains, iv_interval, mp_value
+from tests.support.strategies import (BINARY, box3, elements_for, expression, interval, param_for,
                               samples)
 
 SETTINGS = settings(max_examples=120, deadline=None,
@@ -27,7 +30,7 @@ SETTINGS = settings(max_examples=120, deadline=None,
 def run_kernel(op, boxes, param):
     los = tuple(np.array([b[0]]) for b in boxes)
     his = tuple(np.array([b[1]]) for b in boxes)
-    result = op.interval(los, his, param)
+    result = apply_op(op, param, los, his)
     if op.domain:
         lo, hi, empty = result
         return float(lo[0]), float(hi[0]), bool(np.asarray(empty)[0])
@@ -42,7 +45,7 @@ def check_enclosure(name, boxes, param, rng, n_interior):
     per_arg = [samples(a, b, rng, n_interior) for a, b in boxes]
     with mpmath.workdps(DPS):
         for point in itertools.product(*per_arg):
-            exact = op.reference([mpmath.mpf(v) for v in point], param)
+            exact = apply_reference(op, [mpmath.mpf(v) for v in point], param)
             if exact is None:
                 continue
             assert not empty, f"{name}{boxes} said empty but is defined at {point}"
@@ -50,7 +53,7 @@ def check_enclosure(name, boxes, param, rng, n_interior):
                 f"{name}({point}, param={param}) = {mpmath.nstr(exact, 20)} "
                 f"not in [{lo!r}, {hi!r}] for boxes {boxes}")
             with np.errstate(all="ignore"):
-                value = float(op.point(tuple(np.float64(v) for v in point), param))
+                value = float(apply_point(op, tuple(np.float64(v) for v in point), param))
             if not np.isnan(value):
                 assert lo <= value <= hi, f"numpy {name}{point} = {value!r} outside"
 
@@ -182,8 +185,8 @@ def test_nested_expressions_hold_mpmath_iv_interval(expr, box):
 def test_binary_strategy_covers_every_binary_opcode():
     unary_ops = {n for n, op in OPCODES.items() if op.arity == 1 and not op.internal}
     assert set(BINARY) == {n for n, op in OPCODES.items() if op.arity == 2 and not op.internal}
-    from tests.strategies import TERNARY
+    from tests.support.strategies import TERNARY
     assert set(TERNARY) == {n for n, op in OPCODES.items()
                             if op.arity == 3 and not op.prepare and not op.internal}
-    from tests.strategies import UNARY
+    from tests.support.strategies import UNARY
     assert set(UNARY) | {"powi", "powr"} == unary_ops

@@ -5,7 +5,7 @@ from pathlib import Path
 
 import numpy as np
 
-from tests.clip_oracle import triangle_meets_box
+from tests.support.clip_oracle import triangle_meets_box
 
 def _find_bunny() -> Path:
     """The Stanford bunny in the workspace's shared data (not redistributed with the
@@ -13,11 +13,11 @@ def _find_bunny() -> Path:
     ``/work/shared``."""
     import os
     rel = Path("shared") / "data" / "meshes" / "stanford-bunny.obj"
-    for cand in (os.environ.get("IMPLICITVOX_BUNNY"), Path(__file__).resolve().parents[2] / rel,
+    for cand in (os.environ.get("IMPLICITVOX_BUNNY"), Path(__file__).resolve().parents[3] / rel,
                  Path("/work") / rel):
         if cand and Path(cand).exists():
             return Path(cand)
-    return Path(__file__).resolve().parents[2] / rel
+    return Path(__file__).resolve().parents[3] / rel
 
 
 #: the Stanford bunny (see :func:`_find_bunny`)

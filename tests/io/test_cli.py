@@ -33,7 +33,7 @@ def test_model_file_with_progress_and_output(tmp_path, capsys):
     assert code == 0, err
     assert "100.0%" in err and "surface voxels" in out
     direct = ivx.voxelize(ivx.sqrt(ivx.x**2 + ivx.y**2 + ivx.z**2) - 1,
-                          ((-1.2,) * 3, (1.2,) * 3), 24)
+                          24, bounds=((-1.2,) * 3, (1.2,) * 3))
     assert np.array_equal(ivx.load(str(out_file)).coords(), direct.coords())
 
 
@@ -55,7 +55,7 @@ def test_model_errors_name_the_model_line(tmp_path, capsys, source, match):
     (["voxelize"], "model file or --example"),
     (["voxelize", "--example", "nope"], "unknown example"),
     (["voxelize", "missing.py"], "no such model file"),
-    (["voxelize", "--example", "sphere", "--resolution", "0"], "between 1 and"),
+    (["voxelize", "--example", "sphere", "--resolution", "0"], "resolution must be an int from 1 to"),
     (["voxelize", "--example", "sphere", "--out", "/no/such/dir/v.npz"], "cannot write --out"),
     (["voxelize", "--example", "sphere", "--bounds", "0", "0", "0", "0", "1", "1"], "extent"),
     (["voxelize", "--example", "sinsin918", "--resolution", "8192", "--max-memory", "0.1"],
@@ -69,14 +69,14 @@ def test_bad_input_is_refused_clearly(argv, match, capsys):
 def test_console_entry_point_renders_an_example(tmp_path):
     png = tmp_path / "gear.png"
     env = dict(os.environ, VTK_DEFAULT_OPENGL_WINDOW="vtkEGLRenderWindow")
-    proc = subprocess.run([sys.executable, "-m", "implicitvox.cli", "voxelize", "--example", "gear",
+    proc = subprocess.run([sys.executable, "-m", "implicitvox.io.cli", "voxelize", "--example", "gear",
                            "--resolution", "64", "--render", str(png)],
                           capture_output=True, text=True, env=env, timeout=300)
     assert proc.returncode == 0, proc.stderr
     assert png.stat().st_size > 10_000
 
 
-FIXTURES = os.path.join(os.path.dirname(__file__), "openscad")
+FIXTURES = os.path.join(os.path.dirname(os.path.dirname(__file__)), "openscad")
 
 
 def test_openscad_and_json_models(tmp_path, capsys):

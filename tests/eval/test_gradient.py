@@ -8,8 +8,8 @@ from hypothesis import strategies as st
 
 import implicitvox as ivx
 from implicitvox import x, y, z
-from tests.reference import mp_value
-from tests.strategies import expression
+from tests.support.reference import mp_value
+from tests.support.strategies import expression
 
 SMOOTH_UNARY = ("neg", "square", "exp", "sin", "cos", "atan", "sqrt", "log")
 SMOOTH_BINARY = ("add", "sub", "mul", "div", "hypot", "atan2")

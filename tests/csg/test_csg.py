@@ -14,7 +14,7 @@ from csg import (Blobby, Box, Circle, ConvexPolyhedron, Cylinder, Ellipsoid, Hal
                  Polygon, Polyhedron, Rectangle, SceneError, Sphere, Torus, load_json,
                  linear_extrude, rotate_extrude, smooth_union)
 from implicitvox.expr.shape import AMBIGUOUS, EMPTY, FULL
-from tests.surface import found, surface_brackets
+from tests.support.surface import found, surface_brackets
 
 SPHERE_MESH = pv.Sphere(radius=1.0, theta_resolution=24, phi_resolution=24)
 
@@ -100,7 +100,7 @@ def test_polyhedron_classification_is_exact():
     mesh voxelizer on the same grid), FULL/EMPTY agree with the winding number."""
     solid = Polyhedron(SPHERE_MESH)
     vox = solid.voxelize(32, bounds=((-1.2,) * 3, (1.2,) * 3), interior=True)
-    mesh_vox = ivx.voxelize_mesh(SPHERE_MESH, 32, bounds=((-1.2,) * 3, (1.2,) * 3), solid=True)
+    mesh_vox = ivx.voxelize_mesh(SPHERE_MESH, 32, bounds=((-1.2,) * 3, (1.2,) * 3), interior=True)
     assert np.array_equal(vox.coords(), mesh_vox.coords())
     assert np.array_equal(vox.to_dense(), mesh_vox.to_dense())
     classify = solid.classify_boxes
@@ -114,7 +114,7 @@ def test_which_solids_have_an_exact_test():
     assert Sphere(1).classify_boxes is not None               # max-norm distance
     assert Torus(1, 0.2).rotate((0, 1, 0), 90).classify_boxes is not None
     assert (csg.ExprSolid(ivx.x ** 2 - 1) - Polyhedron(SPHERE_MESH)).classify_boxes is not None
-    from csg.classify import world_linf
+    from csg.classify import world_primitive as world_linf
     assert world_linf(Torus(1, 0.2).rotate((1, 1, 0), 30)).axis is None  # general orientation
     assert world_linf(Torus(0.2, 0.3).rotate((1, 1, 0), 30)) is None  # tilted spindle torus
     assert world_linf(Torus(0.2, 0.3).rotate((1, 0, 0), 90)) is not None  # upright: exact
@@ -125,7 +125,7 @@ def test_exact_leaves_settle_boxes_intervals_cannot():
     rotated corner that the max-norm test settles; both never drop a surface voxel."""
     box = Box((1, 2, 3)).rotate((1, 1, 0), 37).translate((0.1, 0.2, 0.3))
     exact = box.voxelize(48)
-    loose = ivx.voxelize(box.expr, exact.bounds, 48)
+    loose = ivx.voxelize(box.expr, 48, bounds=exact.bounds)
     assert np.all(loose.contains(exact.coords()))
     assert exact.count < loose.count
 
@@ -141,7 +141,7 @@ def test_transforms_compose_and_invert():
 
 
 @pytest.mark.parametrize("make, match", [
-    (lambda: Sphere(-1), "r must be positive"),
+    (lambda: Sphere(-1), "r must be a positive finite number"),
     (lambda: Box((1, 0, 1)), "size must be positive"),
     (lambda: Cylinder(h=1, r=1, r1=2), "give r, or r1 and r2"),
     (lambda: Sphere(1).scale(0), "non-zero"),

@@ -7,7 +7,7 @@ from hypothesis import given, settings
 
 import implicitvox as ivx
 from implicitvox import x, y, z
-from tests.strategies import expression
+from tests.support.strategies import expression
 
 NAMESPACE = {name: getattr(ivx, name) for name in ivx.__all__}
 

@@ -46,7 +46,7 @@ def test_render_refuses_an_unwritable_path(vox):
 
 def test_render_names_the_missing_library(vox, tmp_path, monkeypatch):
     import ctypes.util
-    from implicitvox.io import render as render_module
+    from implicitvox.io import rendering as render_module
     monkeypatch.setattr(ctypes.util, "find_library", lambda name: None)
     with pytest.raises(render_module.RenderError, match="libegl1 libegl-mesa0"):
         vox.render(str(tmp_path / "x.png"))

@@ -7,7 +7,7 @@ import pytest
 
 import implicitvox as ivx
 from implicitvox.interval import rounding
-from tests.reference import contains, mp_value
+from tests.support.reference import contains, mp_value
 
 X = ivx.x
 

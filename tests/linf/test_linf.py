@@ -8,7 +8,7 @@ from scipy.optimize import linprog
 import implicitvox as ivx
 from implicitvox import linf
 from implicitvox.expr.shape import AMBIGUOUS, EMPTY, FULL
-from tests.linf_oracle import (corner_depth, dual_distance, ellipsoid_support, frustum_support,
+from tests.support.linf_oracle import (corner_depth, dual_distance, ellipsoid_support, frustum_support,
                                 quadric_box_range, quadric_distance, torus_surface_distance)
 
 CUBE = np.array([[x, y, z] for x in (0, 1) for y in (0, 1) for z in (0, 1)], dtype=float)
@@ -433,7 +433,7 @@ def test_torus_matches_brute_force(axis, n):
     contact equations) - random, exactly in a coordinate plane (the degenerate
     silhouette), and within 1e-17, 1e-9 and 1e-7 of the degenerate cases.
     Brute force: the max-norm distance to a dense sampling of the surface parameters,
-    refined by nested golden sections (tests.linf_oracle). Any surface point bounds the
+    refined by nested golden sections (tests.support.linf_oracle). Any surface point bounds the
     distance from above, so the distance may never exceed the oracle; where the oracle
     is larger (its refinement can stall where the norm has a kink), SLSQP from 72 starts
     over the surface parameters must agree to 1e-9."""
@@ -514,7 +514,7 @@ def _circle_box_distance(R, lo, hi, n=2048, basins=3):
     local = (f <= np.roll(f, 1, axis=1)) & (f <= np.roll(f, -1, axis=1))
     picks = np.argsort(np.where(local, f, np.inf), axis=1)[:, :basins]
     best = f.min(axis=1)
-    from tests.linf_oracle import _golden_max
+    from tests.support.linf_oracle import _golden_max
     for b in range(basins):
         u0 = u[picks[:, b]]
         best = np.minimum(best, -_golden_max(lambda t: -dist(t), u0 - 2 * np.pi / n,
@@ -558,7 +558,7 @@ def _tilted_circle_box_range(c, e1, e2, a, R, lo, hi, n=256, edge_samples=64):
     the box except on the axis (where ``rho`` has its kink), and along the axis it is
     convex; so the greatest is at a corner, where the axis crosses a face, or on an
     edge (a dense sweep of each edge refined by golden sections)."""
-    from tests.linf_oracle import _golden_max
+    from tests.support.linf_oracle import _golden_max
 
     def to_circle(x):
         y = x - c

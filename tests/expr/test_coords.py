@@ -9,7 +9,7 @@ from hypothesis import strategies as st
 
 import implicitvox as ivx
 from implicitvox import cos, sin
-from tests.reference import contains, mp_value
+from tests.support.reference import contains, mp_value
 
 
 def boundary_samples(lo, hi, k=41):

@@ -9,7 +9,9 @@ from hypothesis import strategies as st
 
 from implicitvox.interval import rounding
 from implicitvox.eval.opcodes import OPCODES
-from tests.strategies import interval
+from implicitvox.eval.reference import apply_reference
+from implicitvox.eval.interval import apply_op
+from tests.support.strategies import interval
 
 # name -> (increasing?, argument strategy)
 MONOTONE = {
@@ -43,10 +45,10 @@ def test_monotone_unary_is_tight(name, data):
     increasing, elements = MONOTONE[name]
     a, b = data.draw(interval(elements))
     op = OPCODES[name]
-    result = op.interval((np.array([a]),), (np.array([b]),), None)
+    result = apply_op(op, None, (np.array([a]),), (np.array([b]),))
     lo, hi = float(result[0][0]), float(result[1][0])
     with mpmath.workdps(50):
-        fa, fb = (op.reference([mpmath.mpf(v)], None) for v in (a, b))
+        fa, fb = (apply_reference(op, [mpmath.mpf(v)], None) for v in (a, b))
         exact_lo, exact_hi = (fa, fb) if increasing else (fb, fa)
         # the end value is off by up to W floats, and the outward step |v| W eps
         # is W to 2 W floats of v's binade (2 W just below a power of two)
@@ -65,9 +67,9 @@ def test_monotone_binary_is_tight(name, a, b):
     """
     bound = 3.5 + (2 * rounding.POW_ULPS if name == "hypot" else 0)
     op = OPCODES[name]
-    lo, hi = op.interval((np.array([a[0]]), np.array([b[0]])),
-                         (np.array([a[1]]), np.array([b[1]])), None)
+    lo, hi = apply_op(op, None, (np.array([a[0]]), np.array([b[0]])),
+                      (np.array([a[1]]), np.array([b[1]])))
     with mpmath.workdps(50):
-        corners = [op.reference([mpmath.mpf(p), mpmath.mpf(q)], None) for p in a for q in b]
+        corners = [apply_reference(op, [mpmath.mpf(p), mpmath.mpf(q)], None) for p in a for q in b]
         assert ulps_apart(float(lo[0]), min(corners)) <= bound
         assert ulps_apart(float(hi[0]), max(corners)) <= bound

@@ -1,6 +1,6 @@
-"""Interval evaluation in float32 (:mod:`implicitvox.precision`): the same promise.
+"""Interval evaluation in float32 (:mod:`implicitvox.eval.precision`): the same promise.
 
-The kernels of :data:`FLOAT32_OPS` run on float32 boxes (rounded outward from
+The kernels of the opcode rows marked ``float32`` run on float32 boxes (rounded outward from
 the float64 ones) and must still enclose the exact range (mpmath, 60 digits);
 numpy's float32 transcendentals must stay within the widening; the
 subdivision picks float32 only where it is allowed, and its voxels hold every
@@ -25,13 +25,15 @@ from implicitvox.expr.coords import cylindrical
 from implicitvox.expr.examples import gear, sinsin
 from implicitvox.octree.grid import Grid
 from implicitvox.eval.opcodes import OPCODES
+from implicitvox.eval.reference import apply_reference
 from implicitvox.expr.shape import ExprShape
-from implicitvox.eval.precision import FLOAT32_OPS, supports_float32
+from implicitvox.eval.opcodes import OPCODES
+from implicitvox.eval.precision import supports_float32
 from implicitvox.interval.float32 import float32_bounds, outward_float32
 from implicitvox.octree.precision import interval_dtype, level_dtype
-from tests.reference import DPS, contains
-from tests.surface import found, surface_brackets
-from tests.strategies import elements_for, interval, param_for, samples
+from tests.support.reference import DPS, contains
+from tests.support.surface import found, surface_brackets
+from tests.support.strategies import elements_for, interval, param_for, samples
 
 F32 = np.float32
 
@@ -45,7 +47,10 @@ def _fit_param(name, param):
     return param
 
 
-@pytest.mark.parametrize("name", sorted(FLOAT32_OPS))
+FLOAT32_OPS = sorted(name for name, op in OPCODES.items() if op.float32)
+
+
+@pytest.mark.parametrize("name", FLOAT32_OPS)
 @settings(max_examples=150, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(data=st.data())
 def test_float32_kernels_enclose_the_exact_range(name, data):
@@ -62,7 +67,7 @@ def test_float32_kernels_enclose_the_exact_range(name, data):
     per_arg = [samples(a, b, rng, 5 if op.arity == 1 else 2) for a, b in boxes]
     with mpmath.workdps(DPS):
         for point in itertools.product(*per_arg):
-            exact = op.reference([mpmath.mpf(v) for v in point], param)
+            exact = apply_reference(op, [mpmath.mpf(v) for v in point], param)
             if exact is not None:
                 assert contains(lo, hi, exact), (
                     f"{name}{point} param={param}: {mpmath.nstr(exact, 20)} not in [{lo!r}, {hi!r}]")
@@ -172,8 +177,8 @@ def test_float32_voxels_hold_every_surface_point(name, shape, monkeypatch):
 
 
 def test_the_never_miss_models_run_in_float32():
-    """So tests/test_never_misses.py checks the float32 path on most models."""
-    from tests.test_never_misses import MODELS
+    """So tests/properties/test_never_misses.py checks the float32 path on most models."""
+    from tests.properties.test_never_misses import MODELS
     single = {name for name, make in MODELS.items() if supports_float32(ivx.compile(make()[0]).tape)}
     assert single >= {"sphere", "torus", "gear", "sinsin34", "sinsin918", "blobby", "thin-sheet",
                       "csg-box-minus-ball", "lobed-plate"}, single

@@ -3,8 +3,8 @@
 The enclosure suite (``test_interval_enclosure.py``) checks each kernel on one
 box at a time against mpmath. Batches of thousands of boxes, as the
 subdivision passes them, take paths a single box never does: constants as
-cached arrays (:mod:`implicitvox.filled`), masked copies instead of
-``np.where`` (:func:`implicitvox.interval.where_set`), the sums' range test in
+cached arrays (:mod:`implicitvox.interval.filled`), masked copies instead of
+``np.where`` (:func:`implicitvox.interval.kernels.where_set`), the sums' range test in
 ``_norm``. Here every opcode runs on one big batch and on small pieces of it,
 in float64 and (where the kernel supports it) float32, and the results must
 be identical bit for bit, so the mpmath proof carries over.
@@ -21,8 +21,7 @@ from implicitvox.eval.interval import apply_op
 from implicitvox.interval.filled import filled_like
 from implicitvox.interval.kernels import where_set
 from implicitvox.eval.opcodes import OPCODES
-from implicitvox.eval.precision import FLOAT32_OPS, _params_fit
-from tests.strategies import param_for
+from tests.support.strategies import param_for
 
 BATCH = 3 * filled.MIN_SIZE
 PIECE = 97   # far below MIN_SIZE: the scalar forms
@@ -69,7 +68,8 @@ def _same_bits(a: np.ndarray, b: np.ndarray) -> bool:
 
 def _float32_ok(name: str, param) -> bool:
     """Would a tape with this instruction run in float32 (as the subdivision does)?"""
-    return name in FLOAT32_OPS and _params_fit(name, param)
+    op = OPCODES[name]
+    return op.float32 and op.float32_params(param)
 
 
 @pytest.mark.parametrize("name", sorted(OPCODES))

@@ -7,7 +7,7 @@ import pytest
 import implicitvox as ivx
 from implicitvox.octree import morton
 from implicitvox.mesh.bezier import bezier_triangles
-from tests.mesh_helpers import misses
+from tests.support.mesh_helpers import misses
 
 
 def _sampled_voxels(vox, patches, n, rng):
@@ -75,9 +75,9 @@ def test_flatness_trades_tightness():
 def test_refine_equals_direct():
     patches = ivx.utah_teapot()
     bounds = ((-4, -4, -1), (4, 4, 7))
-    coarse = ivx.voxelize_bezier(patches, 32, bounds)
+    coarse = ivx.voxelize_bezier(patches, 32, bounds=bounds)
     fine = coarse.refine(1)
-    direct = ivx.voxelize_bezier(patches, 64, bounds)
+    direct = ivx.voxelize_bezier(patches, 64, bounds=bounds)
     assert fine.grid == direct.grid and np.array_equal(fine.coords(), direct.coords())
 
 
