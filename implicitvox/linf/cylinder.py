@@ -39,7 +39,7 @@ import numpy as np
 
 from .. import expr as ex
 
-from .ellipsoid import _roots
+from .ellipsoid import quadratic_roots
 from .classify import Primitive
 from .norm import as_points, as_weights
 
@@ -118,7 +118,7 @@ class Frustum(Primitive):
         B = np.sum(Gd * y, axis=1) + d @ self.g
         C = np.sum((y @ self.G) * y, axis=1) + 2 * (y @ self.g) + self.c0
         with np.errstate(divide="ignore", invalid="ignore"):
-            t1, t2 = _roots(np.where(A != 0, A, 1.0), B, C)
+            t1, t2 = quadratic_roots(np.where(A != 0, A, 1.0), B, C)
             lin = -C / (2 * B)
         real = ~np.isnan(t1)
         inf = np.full_like(t1, np.inf)
@@ -195,7 +195,7 @@ class Frustum(Primitive):
             # every time the line is tangent to the (double) quadric is a candidate: a
             # tangency on the real cone, at a point of the edge, is a genuine contact
             with np.errstate(divide="ignore", invalid="ignore"):
-                r1, r2 = _roots(np.where(A != 0, A, 1.0), B, C)
+                r1, r2 = quadratic_roots(np.where(A != 0, A, 1.0), B, C)
                 lin = np.where(B != 0, -C / (2 * B), np.nan)
             for t1 in (np.where(A != 0, r1, lin), np.where(A != 0, r2, np.nan)):
                 t1 = np.where(t1 >= 0, t1, np.nan)
@@ -213,7 +213,7 @@ class Frustum(Primitive):
             A = np.sum(dz * dz, axis=1)
             B = np.sum(z0 * dz, axis=1)
             C = np.sum(z0 * z0, axis=1) - r * r
-            t1, _ = _roots(A, B, C)
+            t1, _ = quadratic_roots(A, B, C)
             t1 = np.where((C > 0) & (t1 >= 0), t1, np.nan)
             lo_k, hi_k = sorted((0.0, h * a[k]))
             ok = (y[:, k] - t1 * w[:, k] <= hi_k * (1 + _TOL) + _TOL) & \
@@ -240,7 +240,7 @@ class Frustum(Primitive):
                 B = np.sum(q0p * dq, axis=1)
                 C = np.sum(q0p * q0p, axis=1) - r * r
                 with np.errstate(divide="ignore", invalid="ignore"):
-                    t1, _ = _roots(np.where(A > 0, A, 1.0), B, C)
+                    t1, _ = quadratic_roots(np.where(A > 0, A, 1.0), B, C)
                 t1 = np.where((A > 0) & (C > 0) & (t1 >= 0), t1, np.nan)
                 _, yk = point(np.nan_to_num(t1))
                 ok = self._on_edge(yk, y, w, k, t1)

@@ -34,14 +34,14 @@ from .. import expr as ex
 from .classify import Primitive
 from .norm import as_points, as_weights
 
-__all__ = ["Ellipsoid"]
+__all__ = ["Ellipsoid", "quadratic_roots"]
 
 #: the 8 corner rays as 4 lines through p: directions (sx, sy, 1) * w
 _LINE_SIGNS = [(sx, sy) for sx in (-1.0, 1.0) for sy in (-1.0, 1.0)]
 _EDGES = [(i, j, k) for k, (i, j) in enumerate([(1, 2), (2, 0), (0, 1)])]
 
 
-def _roots(A, B, C):
+def quadratic_roots(A, B, C):
     """Roots ``t1 <= t2`` of ``A t^2 + 2 B t + C = 0`` (A > 0), stable; NaN if none."""
     disc = B * B - A * C
     with np.errstate(invalid="ignore", divide="ignore"):

@@ -23,13 +23,14 @@ from __future__ import annotations
 import warnings
 
 import numpy as np
-from scipy import ndimage
-
+from .._lazy import LazyModule
 from ..octree import morton
 from ..octree.grid import Grid
 from .winding import winding_numbers
 
 __all__ = ["interior_octants", "octants_from_dense", "BYTES_PER_VOXEL"]
+
+ndimage = LazyModule("scipy.ndimage")
 
 #: dense working memory of the fill, per grid voxel (mask, labels, interior)
 BYTES_PER_VOXEL = 7

@@ -110,7 +110,7 @@ def _leaf_codes(tris: Triangles, grid: Grid, nodes: np.ndarray, tri: np.ndarray)
     group = np.cumsum(new) - 1
     done = np.zeros(int(group[-1]) + 1 if len(group) else 0, dtype=bool)
     done[group[holds]] = True
-    lo, hi = tris._grown(tri, lo, hi)
+    lo, hi = tris.grown(tri, lo, hi)
     pending = np.flatnonzero(~done[group])
     meets, undecided = tris.plane_stage(tri[pending], lo[pending], hi[pending])
     done[group[pending[meets]]] = True

@@ -119,13 +119,15 @@ class Triangles:
     def meet_overlapping(self, tri: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
         """:meth:`meet_boxes` for boxes already known to overlap their triangle's
         bounding box (the box-normal axes are settled)."""
-        lo, hi = self._grown(tri, lo, hi)
+        lo, hi = self.grown(tri, lo, hi)
         meets, open_ = self.plane_stage(tri, lo, hi)
         undecided = np.flatnonzero(open_)
         meets[undecided] = self.edge_stage(tri[undecided], lo[undecided], hi[undecided])
         return meets
 
-    def _grown(self, tri, lo, hi):
+    def grown(self, tri, lo, hi):
+        """Boxes ``[lo, hi]`` grown by the dilation of triangles ``tri`` (rounded
+        outward): a box meets a grown triangle iff the grown box meets it."""
         if self.dilation is None:
             return lo, hi
         return down(lo - self.dilation[tri]), up(hi + self.dilation[tri])

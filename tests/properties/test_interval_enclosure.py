@@ -187,6 +187,6 @@ def test_binary_strategy_covers_every_binary_opcode():
     assert set(BINARY) == {n for n, op in OPCODES.items() if op.arity == 2 and not op.internal}
     from tests.support.strategies import TERNARY
     assert set(TERNARY) == {n for n, op in OPCODES.items()
-                            if op.arity == 3 and not op.prepare and not op.internal}
+                            if op.arity == 3 and not op.oracle and not op.internal}
     from tests.support.strategies import UNARY
     assert set(UNARY) | {"powi", "powr"} == unary_ops
