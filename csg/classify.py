@@ -37,6 +37,7 @@ from typing import Any, Callable, Optional
 import numpy as np
 
 import implicitvox as iv
+from implicitvox import _batches as batches
 from implicitvox.expr.shape import AMBIGUOUS, EMPTY, FULL
 from implicitvox.mesh.crossings import RayWinding
 from implicitvox.mesh.pairs import sorted_unique
@@ -53,7 +54,7 @@ UNKNOWN, MAYBE = 3, 4
 #: halvings of a box whose state is unknown before it counts as AMBIGUOUS
 SETTLE_DEPTH = 2
 #: unknown boxes settled at once (each may have up to 4**SETTLE_DEPTH sub-boxes in play)
-SETTLE_CHUNK = 2048
+SETTLE_CHUNK = batches.SETTLE_BOXES
 _HALF = CORNERS.astype(bool)
 _BOOLEANS = ("union", "intersection", "difference", "complement")
 

@@ -112,7 +112,7 @@ class Box(Solid):
     def world_linf(self, matrix: np.ndarray) -> linf.Primitive:
         lo, hi = self._lo_hi
         corners = np.where(CORNERS.astype(bool), hi, lo)
-        return linf.ConvexPolytope.from_points(corners @ matrix[:3, :3].T + matrix[:3, 3])
+        return linf.ConvexPolyhedron.from_points(corners @ matrix[:3, :3].T + matrix[:3, 3])
 
     def __repr__(self) -> str:
         return f"Box(size={self.size.tolist()}, center={self.centered})"
@@ -350,8 +350,8 @@ class ConvexPolyhedron(Solid):
 
     def world_linf(self, matrix: np.ndarray) -> linf.Primitive:
         if self.points is not None:
-            return linf.ConvexPolytope.from_points(self.points @ matrix[:3, :3].T + matrix[:3, 3])
-        return linf.ConvexPolytope.from_planes(self.normals, self.offsets).transformed(matrix)
+            return linf.ConvexPolyhedron.from_points(self.points @ matrix[:3, :3].T + matrix[:3, 3])
+        return linf.ConvexPolyhedron.from_planes(self.normals, self.offsets).transformed(matrix)
 
     def __repr__(self) -> str:
         return f"ConvexPolyhedron({len(self.normals)} planes)"

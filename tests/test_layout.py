@@ -19,7 +19,7 @@ PACKAGES = ("implicitvox", "csg")
 
 #: the kernel's layers, bottom first: a module may import its own layer and those below
 LAYERS = [
-    ("implicitvox._validate", "implicitvox._lazy", "implicitvox._version"),
+    ("implicitvox._validate", "implicitvox._lazy", "implicitvox._version", "implicitvox._batches"),
     ("implicitvox.expr",),
     ("implicitvox.interval",),
     ("implicitvox.eval",),

@@ -11,11 +11,12 @@ import numpy as np
 from ..interval import kernels as I
 from ..interval.float32 import exact_in_float32, float32_bounds, outward_float32
 from .tape import Tape
+from .. import _batches as batches
 
 __all__ = ["evaluate_intervals", "apply_op", "CHUNK"]
 
 #: boxes per pass: the working set of a tape (a few dozen arrays) stays in cache
-CHUNK = 1 << 16
+CHUNK = batches.BOXES
 
 
 def evaluate_intervals(tape: Tape, lo: tuple[np.ndarray, np.ndarray, np.ndarray],

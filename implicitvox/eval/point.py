@@ -4,10 +4,11 @@ from __future__ import annotations
 import numpy as np
 
 from .tape import Tape
+from .. import _batches as batches
 
 __all__ = ["evaluate_points", "apply_point"]
 
-CHUNK = 1 << 16
+CHUNK = batches.POINTS
 
 
 def evaluate_points(tape: Tape, xs: np.ndarray, ys: np.ndarray, zs: np.ndarray) -> np.ndarray:

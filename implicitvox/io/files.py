@@ -20,6 +20,7 @@ from typing import Any
 
 import numpy as np
 
+from .. import _validate
 from ..octree.grid import Grid
 from ..octree.store import Octree
 from ..octree.voxels import DEFAULT_DENSE_LIMIT, Voxels
@@ -37,18 +38,10 @@ def _suffix(path: str) -> str:
     return ext
 
 
-def _writable(path: str) -> None:
-    folder = os.path.dirname(os.path.abspath(path))
-    if not os.path.isdir(folder):
-        raise ValueError(f"cannot write {path!r}: folder {folder!r} does not exist")
-    if not os.access(folder, os.W_OK):
-        raise ValueError(f"cannot write {path!r}: folder {folder!r} is not writable")
-
-
 def save(vox: Voxels, path: str) -> str:
     """Write ``vox`` to ``path``; the suffix picks the format. Returns the path."""
     ext = _suffix(path)
-    _writable(path)
+    _validate.writable_path(path)
     {".npz": _save_npz, ".vti": _save_vti, ".binvox": _save_binvox}[ext](vox, str(path))
     return str(path)
 
@@ -135,7 +128,15 @@ def _load_vti(path: str) -> Voxels:
 
 # -- binvox --------------------------------------------------------------------------
 def _save_binvox(vox: Voxels, path: str) -> None:
-    """binvox 1: a cubic ``dim^3`` grid, voxels in x-z-y order (y fastest), RLE bytes."""
+    """binvox 1: a cubic ``dim^3`` grid, voxels in x-z-y order (y fastest), RLE bytes.
+
+    The format has one scale for all three axes: voxels that are not cubes are
+    refused (a ``ValueError``), never written wrong.
+    """
+    if not vox.grid.cubic:
+        raise ValueError(f"binvox stores cubic voxels only (one scale), these are "
+                         f"{vox.grid.voxel_size}: use .npz or .vti, or voxelize with one "
+                         "resolution or voxel_size")
     dim = max(vox.grid.shape)
     if dim ** 3 > DEFAULT_DENSE_LIMIT:
         raise MemoryError(f"binvox is dense: {dim}^3 voxels is too large")
@@ -143,7 +144,7 @@ def _save_binvox(vox: Voxels, path: str) -> None:
     n0, n1, n2 = vox.grid.shape
     dense[:n0, :n1, :n2] = vox.to_dense(interior=bool(vox.interior))
     flat = dense.transpose(0, 2, 1).ravel()  # index = x * dim*dim + z * dim + y
-    scale = max(h * dim for h in vox.grid.voxel_size)
+    scale = vox.grid.voxel_size[0] * dim
     with open(path, "wb") as fh:
         fh.write(b"#binvox 1\n")
         fh.write(f"dim {dim} {dim} {dim}\n".encode())

@@ -6,7 +6,7 @@ inside; ``weights`` per axis, or per point, for non-cubic voxels) and
 the surface meets the closed box - exactly, up to rounding at ties
 (:mod:`implicitvox.linf.classify`).
 
-* :class:`HalfSpace`, :class:`ConvexPolytope` (boxes, oriented boxes, any
+* :class:`HalfSpace`, :class:`ConvexPolyhedron` (boxes, oriented boxes, any
   bounded intersection of half-spaces or convex hull) - §3.1.1, §3.1.2;
 * :class:`Sphere`, :class:`Ellipsoid`, the capped :class:`Cylinder` and the
   cone or :class:`Frustum` (any rigid motion) - §3.2 (contact equations:
@@ -37,14 +37,14 @@ import numpy as np
 
 from .classify import Primitive, classify_by_distance
 from .mesh import TriangleMesh
-from .polytope import ConvexPolytope, HalfSpace, triangle_distance
+from .polyhedron import ConvexPolyhedron, HalfSpace, triangle_distance
 from .sphere import Sphere
 from .ellipsoid import Ellipsoid
 from .cylinder import Cylinder, Frustum
 from .torus import Torus
 from .quadric import Quadric
 
-__all__ = ["linf_distance", "HalfSpace", "ConvexPolytope", "Sphere", "Ellipsoid", "Cylinder", "Frustum",
+__all__ = ["linf_distance", "HalfSpace", "ConvexPolyhedron", "Sphere", "Ellipsoid", "Cylinder", "Frustum",
            "Torus", "Quadric", "TriangleMesh",
            "triangle_distance", "classify_by_distance", "Primitive"]
 
@@ -62,5 +62,5 @@ def linf_distance(shape: Any, points: Any, weights: Any = None) -> np.ndarray:
     if callable(method):
         return method(points, weights)
     raise TypeError(f"no max-norm distance for {type(shape).__name__}: use a primitive of "
-                    "implicitvox.linf (HalfSpace, ConvexPolytope, Sphere, Ellipsoid, Cylinder, "
+                    "implicitvox.linf (HalfSpace, ConvexPolyhedron, Sphere, Ellipsoid, Cylinder, "
                     "Frustum, Torus, Quadric, TriangleMesh)")

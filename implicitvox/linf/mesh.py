@@ -9,7 +9,7 @@ For each query point:
    root for all points at once; a (point, node) pair survives only if the
    node's box - a lower bound - is no farther than the upper bound;
 3. the exact distance to each surviving triangle
-   (:func:`~implicitvox.linf.polytope.triangle_distance`), and the minimum.
+   (:func:`~implicitvox.linf.polyhedron.triangle_distance`), and the minimum.
 
 The sign comes from the exact winding number of a closed mesh
 (:class:`~implicitvox.mesh.crossings.RayWinding`); open meshes give unsigned
@@ -35,12 +35,13 @@ from ..mesh.inputs import as_triangles
 from ..octree import morton
 from .classify import Primitive
 from .norm import as_points, as_weights, in_blocks
-from .polytope import triangle_distance
+from .polyhedron import triangle_distance
+from .. import _batches as batches
 
 __all__ = ["TriangleMesh"]
 
 _NEAREST = 2          # centroids whose triangles set the upper bound
-_BLOCK = 1 << 15      # points per block
+_BLOCK = batches.LINF_MESH_POINTS
 _LEAF = 2             # triangles per leaf of the hierarchy
 
 

@@ -1,4 +1,4 @@
-"""Triangle meshes in: ``(vertices, faces)`` arrays, PyVista objects, or files.
+"""Triangle meshes in: ``(vertices, faces)`` arrays, PyVista or trimesh objects, or files.
 
 Everything is checked here, once, with errors that say what and where: a
 ``(vertices, faces)`` pair gives float vertices ``(v, 3)`` and int faces
@@ -39,10 +39,18 @@ def as_triangles(mesh: Any) -> tuple[np.ndarray, np.ndarray]:
         return _from_pyvista(_read(os.fspath(mesh)), f"file {os.fspath(mesh)!r}")
     if _is_pyvista(mesh):
         return _from_pyvista(mesh, type(mesh).__name__)
+    if _is_trimesh(mesh):
+        return _check(mesh.vertices, mesh.faces)
     if isinstance(mesh, (tuple, list)) and len(mesh) == 2:
         return _check(*mesh)
-    raise TypeError("mesh must be (vertices, faces) arrays, a PyVista mesh or a path to "
-                    f"{'/'.join(MESH_SUFFIXES)}, got {type(mesh).__name__}")
+    raise TypeError("mesh must be (vertices, faces) arrays, a PyVista mesh, a trimesh.Trimesh "
+                    f"or a path to {'/'.join(MESH_SUFFIXES)}, got {type(mesh).__name__}")
+
+
+def _is_trimesh(mesh: Any) -> bool:
+    """A ``trimesh.Trimesh``, recognized without importing trimesh (an optional package)."""
+    return any(c.__module__.startswith("trimesh") and c.__name__ == "Trimesh"
+               for c in type(mesh).__mro__)
 
 
 def _check(vertices: Any, faces: Any) -> tuple[np.ndarray, np.ndarray]:

@@ -37,11 +37,12 @@ from ..octree import morton
 from ..octree.grid import Grid
 from .ranges import expand_boxes
 from .tribox import Triangles, vertex_in_box
+from .. import _batches as batches
 
 __all__ = ["surface_codes", "sorted_unique", "CHUNK"]
 
 #: (node, triangle) pairs per chunk
-CHUNK = 1 << 16
+CHUNK = batches.TRIANGLE_PAIRS
 
 _OFFSETS = morton.CORNERS
 

@@ -18,6 +18,7 @@ Examples
 from __future__ import annotations
 
 import numpy as np
+from .. import _batches as batches
 
 __all__ = ["encode", "decode", "MAX_BITS", "CORNERS"]
 
@@ -45,7 +46,7 @@ def _compact(v: np.ndarray) -> np.ndarray:
     return v
 
 
-_BLOCK = 1 << 16  # rows per pass: the ten shift-and-mask passes stay in cache
+_BLOCK = batches.MORTON
 
 
 def encode(coords: np.ndarray) -> np.ndarray:

@@ -38,12 +38,13 @@ from .precision import interval_dtype, level_dtype
 from ..interval.float32 import outward_float32
 from ..eval.precision import supports_float32
 from ..expr.shape import AMBIGUOUS, EMPTY, FULL
+from .. import _batches as batches
 
 __all__ = ["subdivide", "Subdivision", "classify", "suspect_voxels", "recheck_voxels", "CHUNK",
            "RECHECK"]
 
 #: octants classified per interval evaluation
-CHUNK = 1 << 17
+CHUNK = batches.FRONTIER
 #: default strength of the recheck (:func:`suspect_voxels`; measured in
 #: tests/benchmarks/bench_voxelize.py): 1/4 selects the voxels whose sub-voxels
 #: are predicted to settle them

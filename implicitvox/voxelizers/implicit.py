@@ -26,6 +26,7 @@ from ..octree.store import Octree
 from ..octree.subdivide import RECHECK, subdivide
 from ..octree.voxels import Voxels
 from .memory import memory_budget, refuse_over_budget
+from .. import _batches as batches
 
 __all__ = ["voxelize", "estimate_memory", "grid_of", "ImplicitSource", "voxel_normals"]
 
@@ -34,7 +35,7 @@ _BYTES_PER_VOXEL = 48
 _BYTES_PER_NORMAL = 24
 _PILOT_DEPTH = 6
 #: voxels whose normals are computed per pass
-_NORMALS_CHUNK = 1 << 18
+_NORMALS_CHUNK = batches.NORMALS
 
 
 def grid_of(shape_bounds: Any, bounds: Any, resolution: Any, voxel_size: Any,

@@ -41,7 +41,7 @@ def main() -> None:
     w = rng.uniform(0.5, 2.0, (N, 3))
     rows = [
         ("half-space", linf.HalfSpace((1, 2, 3), 0.5), "-"),
-        ("oriented box (polytope)", linf.ConvexPolytope.from_points(
+        ("oriented box (polytope)", linf.ConvexPolyhedron.from_points(
             (np.array([[x, y, z] for x in (0, 1) for y in (0, 1) for z in (0, 1)]) - 0.5) @ q.T),
          "-"),
         ("sphere (quadric)", linf.Sphere((0.1, 0.2, 0.3), 1.0), "45-50"),

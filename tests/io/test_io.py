@@ -5,12 +5,13 @@ import numpy as np
 import pytest
 
 import implicitvox as ivx
-from implicitvox.expr.examples import sinsin
+from implicitvox.expr.examples import gear, sinsin
 
 
 @pytest.fixture(scope="module")
 def vox():
-    return ivx.voxelize(sinsin(3, 4), resolution=(40, 32, 36), interior=True, normals=True)
+    """Cubic voxels on a box that is not a cube (the gear's short axis)."""
+    return ivx.voxelize(gear(), resolution=40, interior=True, normals=True)
 
 
 def test_npz_round_trips_bit_for_bit(vox, tmp_path):
@@ -39,6 +40,31 @@ def test_binvox_reads_back_with_trimesh(vox, tmp_path):
     assert np.array_equal(np.asarray(grid.matrix, dtype=bool), expected)
     back = ivx.load(path)  # and our own reader agrees
     assert np.array_equal(back.to_dense()[:n0, :n1, :n2], vox.to_dense())
+
+
+def test_binvox_lands_on_the_same_voxels_with_the_binvox_package(vox, tmp_path):
+    """The PyPI ``binvox`` reader: same voxels, at the same world positions."""
+    from binvox import Binvox
+    path = str(tmp_path / "v.binvox")
+    vox.save(path)
+    model = Binvox.read(path, "dense")
+    dim = max(vox.resolution)
+    assert list(model.dims) == [dim] * 3
+    read = np.argwhere(model.data)
+    n0, n1, n2 = vox.resolution
+    expected = np.argwhere(vox.to_dense())
+    assert np.array_equal(read, expected)
+    # world positions from the file's translate and scale alone
+    centres = np.asarray(model.translate) + (read + 0.5) * (model.scale / dim)
+    np.testing.assert_allclose(centres, vox.grid.centers(expected), rtol=0, atol=1e-12)
+
+
+def test_binvox_refuses_voxels_that_are_not_cubes(tmp_path):
+    boxy = ivx.voxelize(sinsin(3, 4), resolution=(40, 32, 36))
+    assert not boxy.grid.cubic
+    with pytest.raises(ValueError, match="binvox stores cubic voxels only"):
+        boxy.save(str(tmp_path / "v.binvox"))
+    assert not (tmp_path / "v.binvox").exists()
 
 
 def test_vti_round_trip(vox, tmp_path):

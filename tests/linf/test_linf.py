@@ -23,7 +23,7 @@ def _rotation(rng):
 _TIGHT = {"primal_feasibility_tolerance": 1e-10, "dual_feasibility_tolerance": 1e-10}
 
 
-def lp_distance(poly: linf.ConvexPolytope, p, w):
+def lp_distance(poly: linf.ConvexPolyhedron, p, w):
     """Brute force outside a polytope: min t s.t. A x <= b, |x - p| <= t w (a linear programme)."""
     A, b = poly.normals, poly.offsets
     # variables (x, t): minimise t
@@ -52,7 +52,7 @@ def test_polytope_matches_linear_programming(name):
     pts = {"cube": CUBE, "rotated box": (CUBE - 0.5) * [1, 2, 0.5] @ _rotation(rng).T,
            "random hull": rng.normal(size=(30, 3)),
            "octahedron": np.vstack([np.eye(3), -np.eye(3)])}[name]
-    poly = linf.ConvexPolytope.from_points(pts)
+    poly = linf.ConvexPolyhedron.from_points(pts)
     n = 10_000
     p = rng.normal(size=(n, 3)) * 1.5
     # also points near vertices and edges, where the contact is a vertex or an edge
@@ -189,7 +189,7 @@ def test_voxelizing_a_rotated_box_gives_exactly_the_voxels_it_meets():
     from implicitvox.mesh.tribox import Triangles
     rng = np.random.default_rng(5)
     corners = (CUBE - 0.5) * [1.3, 0.9, 0.6] @ _rotation(rng).T + 0.05
-    poly = linf.ConvexPolytope.from_points(corners)
+    poly = linf.ConvexPolyhedron.from_points(corners)
     vox = ivx.voxelize(poly, bounds=((-1, -1, -1), (1, 1, 1)), resolution=48)
     from scipy.spatial import ConvexHull
     faces = ConvexHull(corners).simplices

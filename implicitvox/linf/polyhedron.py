@@ -17,7 +17,7 @@ A triangle is a flat polytope (unsigned: its distance is ``max(0, ...)``).
 Examples
 --------
 >>> import numpy as np
->>> cube = ConvexPolytope.from_points(np.array([[x, y, z] for x in (0, 1) for y in (0, 1)
+>>> cube = ConvexPolyhedron.from_points(np.array([[x, y, z] for x in (0, 1) for y in (0, 1)
 ...                                              for z in (0, 1)], dtype=float))
 >>> cube.distance(np.array([[2.0, 0.5, 0.5], [0.5, 0.5, 0.5], [3.0, 4.0, -1.0]])).tolist()
 [1.0, -0.5, 3.0]
@@ -31,11 +31,12 @@ import numpy as np
 from .. import expr as ex
 from .classify import Primitive
 from .norm import as_points, as_weights, in_blocks
+from .. import _batches as batches
 
-__all__ = ["ConvexPolytope", "HalfSpace", "triangle_distance", "CHUNK"]
+__all__ = ["ConvexPolyhedron", "HalfSpace", "triangle_distance", "CHUNK"]
 
 #: points per block (memory: points x axes)
-CHUNK = 1 << 14
+CHUNK = batches.LINF_POINTS
 
 
 def _unique_directions(u: np.ndarray) -> np.ndarray:
@@ -51,7 +52,7 @@ def _unique_directions(u: np.ndarray) -> np.ndarray:
     return u[np.sort(keep)]
 
 
-class ConvexPolytope(Primitive):
+class ConvexPolyhedron(Primitive):
     """A bounded convex polytope: ``n_f . x <= d_f`` with its vertices and edges.
 
     Use :meth:`from_points` (convex hull) or :meth:`from_planes`.
@@ -71,7 +72,7 @@ class ConvexPolytope(Primitive):
         self.low = proj.min(axis=0)                             # min_P u.x per axis
 
     @classmethod
-    def from_points(cls, points: Any) -> "ConvexPolytope":
+    def from_points(cls, points: Any) -> "ConvexPolyhedron":
         """The convex hull of ``points`` (n, 3), which must span a volume."""
         from scipy.spatial import ConvexHull, QhullError
         pts = as_points(points)
@@ -84,7 +85,7 @@ class ConvexPolytope(Primitive):
         return cls(hull.equations[:, :3], -hull.equations[:, 3], pts[hull.vertices], edges)
 
     @classmethod
-    def from_planes(cls, normals: Any, offsets: Any) -> "ConvexPolytope":
+    def from_planes(cls, normals: Any, offsets: Any) -> "ConvexPolyhedron":
         """The intersection of half-spaces ``normals . x <= offsets`` (bounded)."""
         from scipy.optimize import linprog
         from scipy.spatial import HalfspaceIntersection
@@ -99,9 +100,9 @@ class ConvexPolytope(Primitive):
         hs = HalfspaceIntersection(np.c_[n, -d], res.x[:3])
         return cls.from_points(hs.intersections)
 
-    def transformed(self, matrix: np.ndarray) -> "ConvexPolytope":
+    def transformed(self, matrix: np.ndarray) -> "ConvexPolyhedron":
         """The polytope under an affine 4 x 4 map."""
-        return ConvexPolytope.from_points(self.vertices @ matrix[:3, :3].T + matrix[:3, 3])
+        return ConvexPolyhedron.from_points(self.vertices @ matrix[:3, :3].T + matrix[:3, 3])
 
     def distance(self, points: Any, weights: Any = None) -> np.ndarray:
         """Signed weighted max-norm distance (negative inside)."""
