@@ -40,40 +40,46 @@ def _shown(value: Any) -> str:
     return f"{type(value).__name__} {value!r:.60}"
 
 
+def _is_int(value: Any) -> bool:
+    return not isinstance(value, (bool, np.bool_)) and isinstance(value, _INTS)
+
+
+def _is_real(value: Any) -> bool:
+    return not isinstance(value, (bool, np.bool_)) and isinstance(value, _NUMBERS) \
+        and math.isfinite(value)
+
+
 def integer(value: Any, name: str) -> int:
     """An int (numpy ints too, never a bool)."""
-    if isinstance(value, (bool, np.bool_)) or not isinstance(value, _INTS):
+    if not _is_int(value):
         raise ValueError(f"{name} must be an int, got {_shown(value)}")
     return int(value)
 
 
 def positive_int(value: Any, name: str) -> int:
     """An int of at least 1."""
-    if isinstance(value, (bool, np.bool_)) or not isinstance(value, _INTS) or value < 1:
+    if not _is_int(value) or value < 1:
         raise ValueError(f"{name} must be a positive int, got {_shown(value)}")
     return int(value)
 
 
 def int_in(value: Any, name: str, low: int, high: int) -> int:
     """An int in ``[low, high]``."""
-    if isinstance(value, (bool, np.bool_)) or not isinstance(value, _INTS) \
-            or not low <= value <= high:
+    if not _is_int(value) or not low <= value <= high:
         raise ValueError(f"{name} must be an int from {low} to {high}, got {_shown(value)}")
     return int(value)
 
 
 def number(value: Any, name: str) -> float:
     """A finite real number."""
-    if isinstance(value, (bool, np.bool_)) or not isinstance(value, _NUMBERS) \
-            or not math.isfinite(value):
+    if not _is_real(value):
         raise ValueError(f"{name} must be a finite number, got {_shown(value)}")
     return float(value)
 
 
 def positive_number(value: Any, name: str) -> float:
     """A finite number above 0."""
-    if isinstance(value, (bool, np.bool_)) or not isinstance(value, _NUMBERS) \
-            or not math.isfinite(value) or not value > 0:
+    if not _is_real(value) or not value > 0:
         raise ValueError(f"{name} must be a positive finite number, got {_shown(value)}")
     return float(value)
 
@@ -81,8 +87,7 @@ def positive_number(value: Any, name: str) -> float:
 def number_in(value: Any, name: str, low: float, high: float, *,
               open_low: bool = False) -> float:
     """A number in ``[low, high]`` (``(low, high]`` with ``open_low``)."""
-    ok = not isinstance(value, (bool, np.bool_)) and isinstance(value, _NUMBERS) \
-        and (low < value if open_low else low <= value) and value <= high
+    ok = _is_real(value) and (low < value if open_low else low <= value) and value <= high
     if not ok:
         left = "(" if open_low else "["
         raise ValueError(f"{name} must be a number in {left}{low}, {high}], got {_shown(value)}")
@@ -141,19 +146,23 @@ def voxel_size(value: Any, name: str = "voxel_size") -> float | tuple[float, flo
     return positive_number(value, name)
 
 
-def points(value: Any, name: str = "points") -> np.ndarray:
-    """An ``(n, 3)`` float64 array of finite coordinates."""
+def points(value: Any, name: str = "points", *, finite: bool = True) -> np.ndarray:
+    """An ``(n, 3)`` (or one ``(3,)``) float64 array: finite coordinates, or with
+    ``finite=False`` infinities allowed (box corners) but never NaN."""
     try:
         p = np.asarray(value, dtype=np.float64)
     except (TypeError, ValueError, OverflowError):
-        raise ValueError(f"{name} must be an (n, 3) array of numbers, got "
+        raise ValueError(f"{name} must be a real array of shape (n, 3), got "
                          f"{type(value).__name__}") from None
     if p.ndim == 1 and p.shape[0] == 3:
         p = p[None, :]
     if p.ndim != 2 or p.shape[1] != 3:
-        raise ValueError(f"{name} must have shape (n, 3), got {p.shape}")
-    if not np.all(np.isfinite(p)):
-        raise ValueError(f"{name} must be finite")
+        raise ValueError(f"{name} must have shape (n, 3) or (3,), got {p.shape}")
+    bad = ~np.isfinite(p) if finite else np.isnan(p)
+    if bad.any():
+        i = int(np.argwhere(bad)[0][0])
+        raise ValueError(f"{name} holds {'a non-finite value' if finite else 'NaN'} "
+                         f"(row {i})")
     return p
 
 
@@ -174,8 +183,7 @@ def max_memory(value: Any, name: str = "max_memory") -> Optional[int]:
     """``None`` (the default budget) or a positive whole number of bytes, at most 2**62."""
     if value is None:
         return None
-    if isinstance(value, (bool, np.bool_)) or not isinstance(value, _NUMBERS) \
-            or not math.isfinite(value) or not 1 <= value <= 2 ** 62:
+    if not _is_real(value) or not 1 <= value <= 2 ** 62:
         raise ValueError(f"{name} must be a positive number of bytes (at most 2**62), "
                          f"got {_shown(value)}")
     return int(value)

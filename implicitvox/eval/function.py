@@ -21,10 +21,11 @@ from typing import Any
 
 import numpy as np
 
+from .. import _validate
+from ..expr.nodes import Expr
 from .gradient import evaluate_gradients
 from .interval import evaluate_intervals
 from .point import evaluate_points
-from ..expr.nodes import Expr
 from .tape import Tape, build_tape
 
 __all__ = ["Function", "compile"]
@@ -128,8 +129,8 @@ class Function:
         ValueError
             For wrong shapes, NaN, or ``lo > hi``.
         """
-        lo_arr = _box_array(lo, "lo")
-        hi_arr = _box_array(hi, "hi")
+        lo_arr = _validate.points(lo, "lo", finite=False)
+        hi_arr = _validate.points(hi, "hi", finite=False)
         if lo_arr.shape != hi_arr.shape:
             raise ValueError(f"lo and hi must have the same shape (n, 3); got {lo_arr.shape} "
                              f"and {hi_arr.shape}")
@@ -147,19 +148,3 @@ class Function:
         ``dtype`` float32 only where :func:`implicitvox.octree.precision.interval_dtype` allows;
         ``native``: results in ``dtype`` (see :func:`evaluate_intervals`)."""
         return evaluate_intervals(self.tape, lo, hi, dtype, native)
-
-
-def _box_array(a: Any, name: str) -> np.ndarray:
-    try:
-        arr = np.asarray(a, dtype=np.float64)
-    except (TypeError, ValueError):
-        raise ValueError(f"{name} must be a real array of shape (n, 3), got "
-                         f"{type(a).__name__}") from None
-    if arr.ndim == 1 and arr.shape[0] == 3:
-        arr = arr[None, :]
-    if arr.ndim != 2 or arr.shape[1] != 3:
-        raise ValueError(f"{name} must have shape (n, 3) or (3,), got {arr.shape}")
-    if np.isnan(arr).any():
-        i = int(np.argwhere(np.isnan(arr))[0][0])
-        raise ValueError(f"{name} holds NaN (box {i})")
-    return arr

@@ -28,11 +28,11 @@ True
 """
 from __future__ import annotations
 
-import math
 from typing import Any
 
 import numpy as np
 
+from .. import _validate
 from .nodes import Expr, wrap, x, y, z
 
 __all__ = ["repeat", "repeat_polar", "FRAMES"]
@@ -53,22 +53,18 @@ def _spacing_and_count(spacing: Any, count: Any) -> tuple[tuple, tuple]:
         if s is None:
             out.append(None)
             continue
-        if isinstance(s, bool) or not isinstance(s, (int, float, np.integer, np.floating)) \
-                or not math.isfinite(s) or s <= 0:
-            raise ValueError(f"spacing on {a} must be a positive number or None, got {s!r}")
-        out.append(float(s))
+        out.append(_validate.positive_number(s, f"spacing on {a} (or None)"))
     if count is None or isinstance(count, (int, np.integer)):
         counts = (count,) * 3
     else:
         counts = tuple(count)
         if len(counts) != 3:
             raise ValueError(f"count must be None, one int or three, got {count!r}")
-    for a, n in zip("xyz", counts):
-        if n is not None and (isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 1):
-            raise ValueError(f"count on {a} must be a positive int or None, got {n!r}")
+    counts = tuple(None if n is None else _validate.positive_int(n, f"count on {a} (or None)")
+                   for a, n in zip("xyz", counts))
     if all(s is None for s in out):
         raise ValueError("spacing repeats along no axis")
-    return tuple(out), tuple(None if n is None else int(n) for n in counts)
+    return tuple(out), counts
 
 
 def repeat(expr: Any, spacing: Any, count: Any = None) -> Expr:
@@ -91,8 +87,6 @@ def repeat_polar(expr: Any, n: int, axis: str = "z") -> Expr:
     """``n`` copies of ``expr`` turned about ``axis`` by ``2 pi / n`` each
     (gear teeth, bolt circles); copy 0 is ``expr`` itself, centred on the
     first of the other two axes."""
-    if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 1:
-        raise ValueError(f"n must be a positive int, got {n!r}")
-    if axis not in FRAMES:
-        raise ValueError(f"axis must be 'x', 'y' or 'z', got {axis!r}")
-    return Expr("repeat_polar", (x, y, z), (wrap(expr), int(n), axis))
+    n = _validate.positive_int(n, "n")
+    axis = _validate.choice(axis, "axis", tuple(FRAMES))
+    return Expr("repeat_polar", (x, y, z), (wrap(expr), n, axis))

@@ -8,3 +8,6 @@ The libmpi of this project; it imports nothing else of implicitvox.
 * :mod:`.float32` - float32 ends rounded outward;
 * :mod:`.filled` - cached constant arrays for numpy's fast loops.
 """
+from . import derivatives, filled, float32, kernels, rounding
+
+__all__ = ["derivatives", "filled", "float32", "kernels", "rounding"]

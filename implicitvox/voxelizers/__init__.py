@@ -5,3 +5,8 @@
 * :mod:`.bezier` - ``voxelize_bezier``: Bézier patches;
 * :mod:`.memory` - the memory budget and estimates every voxelizer checks first.
 """
+from .implicit import voxelize
+from .mesh import voxelize_mesh
+from .bezier import voxelize_bezier
+
+__all__ = ["voxelize", "voxelize_mesh", "voxelize_bezier"]

@@ -79,7 +79,7 @@ def test_sweeps_compose_and_remap():
 
 
 @pytest.mark.parametrize("call, match", [
-    (lambda: ivx.repeat(BALL, spacing=(-1, None, None)), "positive number"),
+    (lambda: ivx.repeat(BALL, spacing=(-1, None, None)), "positive finite number"),
     (lambda: ivx.repeat(BALL, spacing=(None, None, None)), "no axis"),
     (lambda: ivx.repeat(BALL, spacing=1.0, count=(0, 1, 1)), "positive int"),
     (lambda: ivx.repeat(BALL, spacing=(1, 2)), "three"),
