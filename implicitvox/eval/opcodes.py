@@ -46,7 +46,12 @@ from ..interval import derivatives as D
 from ..interval import kernels as I
 from ..interval.float32 import exact_in_float32, in_float32_range
 
-__all__ = ["Opcode", "OPCODES"]
+__all__ = ["Opcode", "OPCODES", "PERIODIC_LIMIT", "EXP_LIMIT"]
+
+#: periodic functions of larger arguments have no mpmath reference
+PERIODIC_LIMIT = 1e15
+#: nor exp of larger arguments
+EXP_LIMIT = 1e4
 
 
 @dataclass(frozen=True)
@@ -74,6 +79,9 @@ class Opcode:
     constant_operand: bool = False
     #: driven by the evaluators through its parameter (:mod:`implicitvox.eval.oracles`)
     oracle: bool = False
+    #: the mpmath reference is not evaluated beyond this argument magnitude (it would
+    #: need pi or ln 2 to thousands of digits); the value is then "not checked"
+    reference_limit: float | None = None
 
 
 def _un(f):
@@ -279,19 +287,19 @@ _ROWS = [
          rule=D.d_abs, float32=True),
     _row("exp", 1, _un(np.exp), _iun(I.i_exp),
          lambda v, g, o, p: o * g[0], lambda a, p: mpmath.exp(a[0]),
-         rule=D.d_exp, float32=True),
+         rule=D.d_exp, reference_limit=EXP_LIMIT, float32=True),
     _row("log", 1, _un(np.log), _iun(I.i_log),
          lambda v, g, o, p: g[0] / v[0], _mp_log, domain=True,
          rule=D.d_log),
     _row("sin", 1, _un(np.sin), _iun(I.i_sin),
          lambda v, g, o, p: np.cos(v[0]) * g[0], lambda a, p: mpmath.sin(a[0]),
-         rule=D.d_sin, float32=True),
+         rule=D.d_sin, reference_limit=PERIODIC_LIMIT, float32=True),
     _row("cos", 1, _un(np.cos), _iun(I.i_cos),
          lambda v, g, o, p: -np.sin(v[0]) * g[0], lambda a, p: mpmath.cos(a[0]),
-         rule=D.d_cos, float32=True),
+         rule=D.d_cos, reference_limit=PERIODIC_LIMIT, float32=True),
     _row("tan", 1, _un(np.tan), _iun(I.i_tan),
          lambda v, g, o, p: (1.0 + o * o) * g[0], lambda a, p: mpmath.tan(a[0]),
-         rule=D.d_tan),
+         rule=D.d_tan, reference_limit=PERIODIC_LIMIT),
     _row("atan", 1, _un(np.arctan), _iun(I.i_atan),
          lambda v, g, o, p: g[0] / (1.0 + v[0] * v[0]), lambda a, p: mpmath.atan(a[0]),
          rule=D.d_atan),

@@ -15,17 +15,14 @@ from typing import Any, Optional, Sequence
 
 import mpmath
 
-from .opcodes import OPCODES
+from .opcodes import EXP_LIMIT, OPCODES, PERIODIC_LIMIT
 from .tape import compiled_oracle
 
 __all__ = ["mp_evaluate", "apply_reference", "PERIODIC_LIMIT", "EXP_LIMIT"]
 
-#: periodic functions of larger arguments are not evaluated (mpmath would
-#: need pi to thousands of digits); the result is None ("not checked")
-PERIODIC_LIMIT = mpmath.mpf(10) ** 15
-#: likewise exp of larger arguments (ln 2 to as many digits)
-EXP_LIMIT = mpmath.mpf(10) ** 4
-_PERIODIC = {"sin", "cos", "tan"}
+#: the opcode rows' limits (``Opcode.reference_limit``) as mpmath numbers
+PERIODIC_LIMIT = mpmath.mpf(PERIODIC_LIMIT)
+EXP_LIMIT = mpmath.mpf(EXP_LIMIT)
 
 
 def mp_evaluate(expr: Any, point: Sequence[Any], dps: int = 60) -> Optional[Any]:
@@ -44,9 +41,8 @@ def mp_evaluate(expr: Any, point: Sequence[Any], dps: int = 60) -> Optional[Any]
                 args = [vals[id(a)] for a in node.args]
                 if any(a is None for a in args):
                     v = None
-                elif node.op in _PERIODIC and abs(args[0]) > PERIODIC_LIMIT:
-                    v = None
-                elif node.op == "exp" and abs(args[0]) > EXP_LIMIT:
+                elif OPCODES[node.op].reference_limit is not None and \
+                        abs(args[0]) > OPCODES[node.op].reference_limit:
                     v = None
                 else:
                     v = apply_reference(OPCODES[node.op], args, node.param)
