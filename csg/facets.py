@@ -39,18 +39,37 @@ from implicitvox import Expr, x, y
 from .triangulate import triangulate
 
 __all__ = ["fragments", "circle_points", "sphere_points", "cylinder_points",
-           "polygonal_radius", "extrusion_mesh"]
+           "polygonal_radius", "extrusion_mesh", "MAX_FRAGMENTS", "MAX_SPHERE_POINTS"]
 
 GRID_FINE = 0.00000095367431640625
 
 
+#: fragments per circle at most ($fn = 10000 is far beyond what a model needs; an OpenSCAD
+#: sphere of n fragments has n (n + 1) / 2 vertices)
+MAX_FRAGMENTS = 10_000
+#: vertices of one faceted sphere at most (n = 2828 fragments)
+MAX_SPHERE_POINTS = 4_000_000
+
+
 def fragments(r: float, fn: float = 0.0, fs: float = 2.0, fa: float = 12.0) -> int:
-    """OpenSCAD's ``get_fragments_from_r``."""
+    """OpenSCAD's ``get_fragments_from_r``, refused above :data:`MAX_FRAGMENTS`.
+
+    Raises
+    ------
+    ValueError
+        If ``$fn``, ``$fa`` or ``$fs`` ask for more than :data:`MAX_FRAGMENTS`
+        fragments (a real model stays far below; raise the limit to go further).
+    """
     if r < GRID_FINE:
         return 3
     if fn > 0:
-        return int(fn) if fn >= 3 else 3
-    return int(math.ceil(max(min(360.0 / fa, r * 2 * math.pi / fs), 5)))
+        n = float(fn) if fn >= 3 else 3.0
+    else:
+        n = math.ceil(max(min(360.0 / fa, r * 2 * math.pi / fs), 5))
+    if not n <= MAX_FRAGMENTS:
+        raise ValueError(f"$fn/$fa/$fs ask for {n:.4g} fragments per circle, over the limit "
+                         f"of {MAX_FRAGMENTS} (csg.facets.MAX_FRAGMENTS)")
+    return int(n)
 
 
 def _cos_sin_degrees(deg: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -73,8 +92,12 @@ def circle_points(r: float, n: int) -> np.ndarray:
 
 
 def sphere_points(r: float, n: int) -> np.ndarray:
-    """Vertices of OpenSCAD's sphere with ``n`` fragments."""
+    """Vertices of OpenSCAD's sphere with ``n`` fragments (at most
+    :data:`MAX_SPHERE_POINTS` of them, else ``ValueError``)."""
     rings = (n + 1) // 2
+    if rings * n > MAX_SPHERE_POINTS:
+        raise ValueError(f"a sphere of {n} fragments has {rings * n:,} vertices, over the limit "
+                         f"of {MAX_SPHERE_POINTS:,} (csg.facets.MAX_SPHERE_POINTS)")
     phi = 180.0 * (np.arange(rings) + 0.5) / rings
     c, s = _cos_sin_degrees(phi)
     pts = []

@@ -37,7 +37,11 @@ from .planar import Circle, LinearExtrude, Polygon, Rectangle, RotateExtrude
 from .primitives import Box, ConvexPolyhedron, Cylinder, Polyhedron, Sphere
 from .solid import Difference, Intersection, Solid, Transformed, Union
 
-__all__ = ["read_openscad", "SUPPORTED", "UNSUPPORTED"]
+__all__ = ["read_openscad", "SUPPORTED", "UNSUPPORTED", "MAX_SLICES"]
+
+#: slices of a twisted or scaled extrusion at most (OpenSCAD's own default is 1 per
+#: few degrees of twist: real models stay in the hundreds)
+MAX_SLICES = 10_000
 
 SUPPORTED = ("group", "union", "difference", "intersection", "multmatrix", "cube", "sphere",
              "cylinder", "polyhedron", "circle", "square", "polygon", "linear_extrude",
@@ -259,7 +263,7 @@ class _Builder:
         tris = []
         for k, face in enumerate(faces):
             if not isinstance(face, list) or len(face) < 3 or not all(
-                    isinstance(i, float) and i == int(i) and 0 <= i < len(v) for i in face):
+                    isinstance(i, float) and 0 <= i < len(v) and i == int(i) for i in face):
                 raise self.error(node, f"polyhedron: faces[{k}] must list >= 3 indices into "
                                        f"points (0..{len(v) - 1})")
             idx = [int(i) for i in face]
@@ -308,7 +312,11 @@ class _Builder:
         center = self.flag(node, "center")
         if not self.faceted or (twist == 0 and scale[0] == scale[1]):
             return LinearExtrude(body, h, twist, scale, center)
-        slices = max(int(self.number(node, "slices", 1.0)), 1)
+        slices = self.number(node, "slices", 1.0)
+        if not slices <= MAX_SLICES:
+            raise self.error(node, f"linear_extrude: slices = {slices:.4g}, over the limit of "
+                                   f"{MAX_SLICES} (csg.openscad.MAX_SLICES)")
+        slices = max(int(slices), 1)
         return self._extrude_tree(node, body, np.eye(4), (h, twist, scale, slices,
                                                          -h / 2 if center else 0.0))
 

@@ -63,6 +63,15 @@ LIMITS = {"text_bytes": 200 << 20, "depth": 100, "nodes": 100_000, "array": 5_00
           "expr_chars": 1 << 20}
 
 
+#: the node types a scene may hold: the reader dispatches through this table only, so a
+#: "type" string never reaches any other attribute of the reader
+NODE_TYPES = frozenset({
+    "sphere", "box", "cylinder", "torus", "ellipsoid", "halfspace", "convex_polyhedron",
+    "polyhedron", "circle", "rectangle", "polygon", "union", "intersection", "difference",
+    "complement", "transform", "linear_extrude", "rotate_extrude", "smooth", "blobby",
+    "expression"})
+
+
 class SceneError(ValueError):
     """A scene that cannot be read, with the JSON path of the problem."""
 
@@ -130,7 +139,7 @@ class _Reader:
         if not isinstance(node, dict):
             raise SceneError(f"{path}: a node must be an object, got {type(node).__name__}")
         kind = node.get("type")
-        reader = getattr(self, f"_{kind}", None) if isinstance(kind, str) else None
+        reader = getattr(self, f"_{kind}") if kind in NODE_TYPES else None
         if reader is None:
             raise SceneError(f"{path}.type: unknown node type {kind!r}")
         try:
@@ -310,24 +319,57 @@ _BINARY = {ast.Add: lambda a, b: a + b, ast.Sub: lambda a, b: a - b,
            ast.Pow: lambda a, b: a ** b}
 
 
+def _refuse(node: ast.AST, where: str, why: str) -> SceneError:
+    return SceneError(f"{where}: column {getattr(node, 'col_offset', 0) + 1}: {why}")
+
+
+def _folded(node: ast.AST, where: str, op, *args) -> Any:
+    """``op`` on the arguments; on numbers alone it is folded in floats, and a fold
+    that overflows, divides by zero or leaves the reals is refused (Python's own
+    integer arithmetic is never used: ``9**9**9`` is one float overflow, not a hang)."""
+    numbers = all(isinstance(a, float) for a in args)
+    try:
+        result = op(*args)
+    except ZeroDivisionError:
+        raise _refuse(node, where, "division by zero in a constant") from None
+    except OverflowError:
+        raise _refuse(node, where, "a constant overflows (beyond 1.8e308)") from None
+    except (TypeError, ValueError) as err:
+        raise _refuse(node, where, f"{err}") from None
+    if numbers and isinstance(result, (float, complex)):
+        if isinstance(result, complex):
+            raise _refuse(node, where, "a constant is not a real number (a negative base "
+                                       "to a fractional power)")
+        if not math.isfinite(result) and all(math.isfinite(a) for a in args):
+            raise _refuse(node, where, "a constant overflows (beyond 1.8e308)")
+    return result
+
+
 def _build(node: ast.AST, where: str) -> Any:
     if isinstance(node, ast.Constant) and isinstance(node.value, (int, float)) and \
             not isinstance(node.value, bool):
-        return node.value
+        try:
+            value = float(node.value)
+        except OverflowError:
+            value = math.inf
+        if not math.isfinite(value):
+            raise _refuse(node, where, "a number overflows (beyond 1.8e308; write inf for "
+                                       "infinity)")
+        return value
     if isinstance(node, ast.Name) and node.id in _VARIABLES:
         return _VARIABLES[node.id]
     if isinstance(node, ast.Name) and node.id in ("inf", "pi"):
         return {"inf": math.inf, "pi": math.pi}[node.id]
     if isinstance(node, ast.BinOp) and type(node.op) in _BINARY:
-        return _BINARY[type(node.op)](_build(node.left, where), _build(node.right, where))
+        return _folded(node, where, _BINARY[type(node.op)], _build(node.left, where),
+                       _build(node.right, where))
     if isinstance(node, ast.UnaryOp) and isinstance(node.op, (ast.USub, ast.UAdd)):
         v = _build(node.operand, where)
         return -v if isinstance(node.op, ast.USub) else v
     if isinstance(node, ast.Call) and isinstance(node.func, ast.Name) and \
             node.func.id in _FUNCTIONS and not node.keywords:
         args = [_build(a, where) for a in node.args]
-        result = _FUNCTIONS[node.func.id](*args)
-        return result
+        return _folded(node, where, _FUNCTIONS[node.func.id], *args)
     what = type(node).__name__
     name = getattr(node, "id", None) or getattr(getattr(node, "func", None), "id", None)
     raise SceneError(f"{where}: column {getattr(node, 'col_offset', 0) + 1}: {what}"

@@ -21,14 +21,19 @@ from typing import Any
 import numpy as np
 
 from .. import _validate
-from ..octree.grid import Grid
+from ..octree.grid import MAX_RESOLUTION, Grid
 from ..octree.store import Octree
 from ..octree.voxels import DEFAULT_DENSE_LIMIT, Voxels
 
-__all__ = ["save", "load", "FORMATS"]
+__all__ = ["save", "load", "FORMATS", "NPZ_LIMIT", "BINVOX_LIMIT"]
 
 FORMATS = (".npz", ".vti", ".binvox")
 _NPZ_VERSION = 1
+#: bytes an .npz may unpack to at most (checked before anything is read)
+NPZ_LIMIT = 16 << 30
+#: voxels a .binvox may declare at most (the format is dense: one byte each in memory)
+BINVOX_LIMIT = 1 << 31
+_BINVOX_HEADER_LINES, _BINVOX_HEADER_LINE = 64, 4096
 
 
 def _suffix(path: str) -> str:
@@ -76,25 +81,94 @@ def _save_npz(vox: Voxels, path: str) -> None:
 
 
 def _load_npz(path: str) -> Voxels:
+    """Every field checked before it is trusted (types, shapes, sizes against each
+    other and against the octree's rules); a bad file is refused whole."""
+    def bad(field: str, why: str) -> ValueError:
+        return ValueError(f"{path!r}: field {field!r}: {why}")
+
     try:
         data = np.load(path, allow_pickle=False)
-    except (ValueError, OSError) as err:
+    except (ValueError, OSError, EOFError) as err:
         raise ValueError(f"{path!r} is not an implicitvox .npz file: {err}") from None
+    if not hasattr(data, "files"):
+        raise ValueError(f"{path!r} is not an implicitvox .npz file (one array, not an archive)")
     with data:
-        if "format" not in data or int(data["format"][0]) != _NPZ_VERSION:
+        unpacked = sum(info.file_size for info in data.zip.infolist())
+        if unpacked > NPZ_LIMIT:
+            raise ValueError(f"{path!r} unpacks to {unpacked / 2**30:.2f} GiB, over the limit "
+                             f"of {NPZ_LIMIT / 2**30:.0f} GiB (implicitvox.io.files.NPZ_LIMIT)")
+        try:
+            version = data["format"] if "format" in data else None
+        except ValueError as err:
+            raise ValueError(f"{path!r} is not an implicitvox .npz file: {err}") from None
+        if version is None or version.shape != (1,) or version.dtype.kind not in "iu" \
+                or int(version[0]) != _NPZ_VERSION:
             raise ValueError(f"{path!r} is not an implicitvox .npz file (version {_NPZ_VERSION})")
-        depth = int(data["depth"][0])
-        masks = [data[f"masks_{lvl}"] for lvl in range(depth) if f"masks_{lvl}" in data]
-        if depth == 0 and "masks_0" in data:
-            masks = [data["masks_0"]]
-        first = [data[f"first_{lvl}"] for lvl in range(max(depth - 1, 0))] if masks else []
-        payload = {k[len("payload_"):]: data[k] for k in data.files if k.startswith("payload_")}
-        interior = {int(k[len("interior_"):]): data[k] for k in data.files
-                    if k.startswith("interior_")}
-        grid = Grid(tuple(data["origin"].tolist()), tuple(data["voxel_size"].tolist()),
-                    tuple(int(v) for v in data["shape"]))
-        metadata = json.loads(str(data["metadata"]))
-    return Voxels(grid, Octree(depth, masks, first, payload), interior, metadata)
+
+        def field(name: str, kind: str, shape: tuple | None = None) -> np.ndarray:
+            if name not in data:
+                raise bad(name, "missing")
+            try:
+                a = data[name]
+            except ValueError as err:
+                raise bad(name, f"unreadable ({err})") from None
+            if a.dtype.kind not in kind:
+                raise bad(name, f"has dtype {a.dtype}")
+            if shape is not None and a.shape != shape:
+                raise bad(name, f"must have shape {shape}, got {a.shape}")
+            return a
+
+        origin = field("origin", "f", (3,))
+        size = field("voxel_size", "f", (3,))
+        shape = field("shape", "iu", (3,))
+        depth_a = field("depth", "iu", (1,))
+        if not np.all(np.isfinite(origin)):
+            raise bad("origin", f"must be finite, got {origin.tolist()}")
+        if not (np.all(np.isfinite(size)) and np.all(size > 0)):
+            raise bad("voxel_size", f"must be positive and finite, got {size.tolist()}")
+        if not np.all((shape >= 1) & (shape <= MAX_RESOLUTION)):
+            raise bad("shape", f"must be 3 counts from 1 to {MAX_RESOLUTION}, got "
+                               f"{shape.tolist()}")
+        grid = Grid(tuple(float(v) for v in origin), tuple(float(v) for v in size),
+                    tuple(int(v) for v in shape))
+        depth = int(depth_a[0])
+        if depth != grid.depth:
+            raise bad("depth", f"a grid of {grid.shape} has depth {grid.depth}, got {depth}")
+        n_masks = max(depth, 1) if "masks_0" in data else 0
+        masks = [field(f"masks_{lvl}", "u") for lvl in range(n_masks)]
+        first = [field(f"first_{lvl}", "u") for lvl in range(max(n_masks - 1, 0))]
+        payload = {k[len("payload_"):]: field(k, "f") for k in data.files
+                   if k.startswith("payload_")}
+        tree = Octree(depth, masks, first, payload)
+        try:
+            tree.validate()
+        except ValueError as err:
+            raise ValueError(f"{path!r}: the octree is inconsistent: {err}") from None
+        if tree.count and not np.all(tree.coords() < np.asarray(grid.shape)):
+            raise bad("masks", f"voxels lie outside the grid {grid.shape}")
+        if "normals" in payload and (payload["normals"].ndim != 2
+                                     or payload["normals"].shape[1] != 3):
+            raise bad("payload_normals", f"must have shape (n, 3), got {payload['normals'].shape}")
+        interior = {}
+        for k in data.files:
+            if not k.startswith("interior_"):
+                continue
+            level = k[len("interior_"):]
+            if not level.isdigit() or not 0 <= int(level) <= depth:
+                raise bad(k, f"the level must be 0 to {depth}")
+            c = field(k, "iu")
+            span = np.asarray([-(-n // (1 << (depth - int(level)))) for n in grid.shape])
+            if c.ndim != 2 or c.shape[1] != 3 or (len(c) and not np.all((c >= 0) & (c < span))):
+                raise bad(k, f"must be (n, 3) octant coordinates below {span.tolist()}")
+            interior[int(level)] = c.astype(np.int32)
+        text = field("metadata", "U", ())
+        try:
+            metadata = json.loads(str(text))
+        except ValueError as err:
+            raise bad("metadata", f"is not JSON ({err})") from None
+        if not isinstance(metadata, dict):
+            raise bad("metadata", "must be a JSON object")
+    return Voxels(grid, tree, interior, metadata)
 
 
 # -- vti -----------------------------------------------------------------------------
@@ -177,8 +251,8 @@ def _load_binvox(path: str) -> Voxels:
         header: dict[str, Any] = {}
         if fh.readline().strip() != b"#binvox 1":
             raise ValueError(f"{path!r} is not a binvox 1 file")
-        while True:
-            line = fh.readline()
+        for _ in range(_BINVOX_HEADER_LINES):
+            line = fh.readline(_BINVOX_HEADER_LINE)
             if not line:
                 raise ValueError(f"{path!r}: binvox header ends before 'data'")
             words = line.decode("ascii", "replace").split()
@@ -186,6 +260,9 @@ def _load_binvox(path: str) -> Voxels:
                 break
             if words:
                 header[words[0]] = words[1:]
+        else:
+            raise ValueError(f"{path!r}: no 'data' line in the first {_BINVOX_HEADER_LINES} "
+                             "lines of the binvox header")
         raw = np.frombuffer(fh.read(), dtype=np.uint8)
     try:
         dims = [int(v) for v in header["dim"]]
@@ -193,10 +270,23 @@ def _load_binvox(path: str) -> Voxels:
         scale = float(header.get("scale", [1.0])[0])
     except (KeyError, ValueError, IndexError):
         raise ValueError(f"{path!r}: bad binvox header {header}") from None
+    if len(dims) != 3 or not all(1 <= d <= MAX_RESOLUTION for d in dims):
+        raise ValueError(f"{path!r}: field 'dim' must be 3 counts from 1 to {MAX_RESOLUTION}, "
+                         f"got {dims}")
+    total = dims[0] * dims[1] * dims[2]
+    if total > BINVOX_LIMIT:
+        raise ValueError(f"{path!r}: {dims} is {total:,} voxels, over the limit of "
+                         f"{BINVOX_LIMIT:,} (implicitvox.io.files.BINVOX_LIMIT; binvox is dense)")
+    if len(origin) != 3 or not all(np.isfinite(origin)):
+        raise ValueError(f"{path!r}: field 'translate' must be 3 finite numbers, got {origin}")
+    if not (np.isfinite(scale) and scale > 0):
+        raise ValueError(f"{path!r}: field 'scale' must be positive and finite, got {scale}")
+    if raw.size % 2:
+        raise ValueError(f"{path!r}: the run-length data has an odd number of bytes")
     values, counts = raw[0::2], raw[1::2].astype(np.int64)
+    if int(counts.sum()) != total:
+        raise ValueError(f"{path!r}: {int(counts.sum())} voxels in the data, header says {dims}")
     flat = np.repeat(values.astype(bool), counts)
-    if flat.size != dims[0] * dims[1] * dims[2]:
-        raise ValueError(f"{path!r}: {flat.size} voxels in the data, header says {dims}")
     dense = flat.reshape(dims[0], dims[2], dims[1]).transpose(0, 2, 1)
     size = scale / max(dims)
     grid = Grid(origin, (size, size, size), tuple(dims))

@@ -27,6 +27,8 @@ from typing import Any
 
 import numpy as np
 
+from .declared import check_declared_sizes
+
 __all__ = ["as_triangles", "MESH_SUFFIXES"]
 
 #: file types read through PyVista
@@ -100,6 +102,7 @@ def _read(path: str):
                          f"{', '.join(MESH_SUFFIXES)}")
     if os.path.getsize(path) == 0:
         raise ValueError(f"cannot read {path!r}: the file is empty")
+    check_declared_sizes(path)      # before VTK allocates what the file declares
     vtk_errors = _Collect()
     root = logging.getLogger()
     root.addHandler(vtk_errors)      # VTK's messages come through logging: keep them

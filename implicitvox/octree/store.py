@@ -151,6 +151,50 @@ class Octree:
             level_codes = parents[starts]
         return cls(depth, masks, first, payload)
 
+    def validate(self) -> None:
+        """Check that the arrays describe an octree, before anything trusts them.
+
+        Raises
+        ------
+        ValueError
+            Naming the broken rule: the depth, an array's type or length, a
+            level's length against its parents' child bits, ``first`` against
+            the counts, a payload's length against the voxels.
+        """
+        d = self.depth
+        if isinstance(d, bool) or not isinstance(d, (int, np.integer)) \
+                or not 0 <= d <= morton.MAX_BITS:
+            raise ValueError(f"depth must be an int from 0 to {morton.MAX_BITS}, got {d!r:.40}")
+        if not self.masks:
+            if self.first:
+                raise ValueError("an empty octree has no 'first' arrays")
+            return
+        if len(self.masks) != max(d, 1) or len(self.first) != max(d - 1, 0):
+            raise ValueError(f"a depth-{d} octree has {max(d, 1)} mask and {max(d - 1, 0)} "
+                             f"'first' arrays, got {len(self.masks)} and {len(self.first)}")
+        for level, m in enumerate(self.masks):
+            if not isinstance(m, np.ndarray) or m.dtype != np.uint8 or m.ndim != 1:
+                raise ValueError(f"masks[{level}] must be a 1-D uint8 array")
+            if not np.all(m):
+                raise ValueError(f"masks[{level}] holds a node without children")
+        if len(self.masks[0]) != 1:
+            raise ValueError(f"masks[0] is the root: 1 node, got {len(self.masks[0])}")
+        for level in range(len(self.masks) - 1):
+            counts = _POPCOUNT[self.masks[level]].astype(np.int64)
+            if int(counts.sum()) != len(self.masks[level + 1]):
+                raise ValueError(f"masks[{level}] has {int(counts.sum())} children, but "
+                                 f"masks[{level + 1}] holds {len(self.masks[level + 1])} nodes")
+            f = self.first[level]
+            if not isinstance(f, np.ndarray) or f.dtype != np.uint32 or f.shape != counts.shape \
+                    or not np.array_equal(f, np.cumsum(counts) - counts):
+                raise ValueError(f"first[{level}] must be the uint32 running count of "
+                                 f"masks[{level}]'s children")
+        n = self.count
+        for name, v in self.payload.items():
+            if not isinstance(v, np.ndarray) or len(v) != n:
+                raise ValueError(f"payload {name!r} must have one row per voxel ({n}), got "
+                                 f"{len(v) if hasattr(v, '__len__') else type(v).__name__}")
+
     # -- queries -------------------------------------------------------------------
     @property
     def count(self) -> int:
