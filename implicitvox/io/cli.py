@@ -115,7 +115,13 @@ def load_model(path: str, **options: Any) -> Any:
 
 def _parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="implicitvox",
-                                     description="Robust voxelization of implicit solids.")
+                                     description="Robust voxelization of implicit solids.",
+                                     epilog="A .py model file is Python and is executed: run "
+                                            "only model files you trust. Every other format "
+                                            "(.csg, .json, meshes, voxel files) is read as "
+                                            "data.")
+    parser.add_argument("--debug", action="store_true",
+                        help="show the traceback of an error (for bug reports)")
     sub = parser.add_subparsers(dest="command", required=True)
     sub.add_parser("examples", help="list the built-in example models")
     vox = sub.add_parser("voxelize", help="voxelize a model")
@@ -192,7 +198,9 @@ def _voxelize(args: argparse.Namespace) -> int:
 
 
 def main(argv: Optional[Sequence[str]] = None) -> int:
-    """Entry point; returns the exit status (2 for bad input)."""
+    """Entry point; returns the exit status: 0, 2 for bad input (one line on stderr,
+    naming it), 1 for anything else (one line; ``--debug`` shows the traceback),
+    130 when interrupted."""
     args = _parser().parse_args(argv)
     try:
         if args.command == "examples":
@@ -200,9 +208,20 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
                 print(f"{name:<14}{description}")
             return 0
         return _voxelize(args)
-    except (ModelError, ValueError, TypeError, MemoryError, FileNotFoundError) as err:
+    except (ModelError, ValueError, TypeError, MemoryError, OSError) as err:
+        if args.debug:
+            traceback.print_exc()
         print(f"implicitvox: error: {err}", file=sys.stderr)
         return 2
+    except KeyboardInterrupt:
+        print("implicitvox: interrupted", file=sys.stderr)
+        return 130
+    except Exception as err:  # noqa: BLE001 - the one place that turns the rest into a line
+        if args.debug:
+            traceback.print_exc()
+        print(f"implicitvox: internal error: {type(err).__name__}: {err} (run with --debug "
+              "for the traceback, and please report it)", file=sys.stderr)
+        return 1
 
 
 if __name__ == "__main__":

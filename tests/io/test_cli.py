@@ -116,3 +116,16 @@ def test_mesh_model(tmp_path, capsys):
     assert code == 0 and "interior voxels" in out, err
     code, _, err = run(["voxelize", str(path), "--normals"], capsys)
     assert code == 2 and "implicit models" in err
+
+
+def test_an_unexpected_error_is_one_line_unless_debug(monkeypatch, capsys):
+    from implicitvox.io import cli
+
+    def broken(args):
+        raise RuntimeError("a bug")
+    monkeypatch.setattr(cli, "_voxelize", broken)
+    assert cli.main(["voxelize", "--example", "sphere"]) == 1
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "internal error: RuntimeError: a bug" in err
+    assert cli.main(["--debug", "voxelize", "--example", "sphere"]) == 1
+    assert "Traceback" in capsys.readouterr().err
