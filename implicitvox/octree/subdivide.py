@@ -32,6 +32,7 @@ import numpy as np
 
 from ..eval.function import Function
 from .grid import Grid
+from .guard import MemoryGuard
 from . import morton
 from ..eval.mean_value import mean_value_enclosure
 from .precision import interval_dtype, level_dtype
@@ -352,7 +353,7 @@ class _Progress:
 def subdivide(func: Function, grid: Grid, *, start: Optional[tuple[int, np.ndarray]] = None,
               interior: bool = False, exact=None, progress=None, chunk: int = CHUNK,
               mean_value: bool = False, exact_voxels=None,
-              recheck: float = RECHECK) -> Subdivision:
+              recheck: float = RECHECK, guard: Optional[MemoryGuard] = None) -> Subdivision:
     """Classify octants from the root (or from ``start``) down to the voxels.
 
     Parameters
@@ -380,6 +381,9 @@ def subdivide(func: Function, grid: Grid, *, start: Optional[tuple[int, np.ndarr
     recheck : float, default: RECHECK
         Strength of the recheck of suspect voxels on their 8 sub-voxels
         (:func:`suspect_voxels`, :func:`recheck_voxels`); 0 turns it off.
+    guard : MemoryGuard, optional
+        Asked after every step with the surface voxels kept and the octants
+        pending or interior; it stops the run (``MemoryError``) past its budget.
     """
     depth = grid.depth
     per_step = max(1, chunk // 8)
@@ -409,24 +413,30 @@ def subdivide(func: Function, grid: Grid, *, start: Optional[tuple[int, np.ndarr
     voxel_dtype = level_dtype(grid, depth) if single else np.float64
     suspects: list[np.ndarray] = []
     pending = 0
+    kept = sum(len(c) for c in surface)
+    held = sum(len(k) for _, k in stack)   # pending and interior octant keys
 
     def settle_suspects() -> int:
         codes = np.concatenate(suspects)
         suspects.clear()
         met, full, classified = recheck_voxels(func, grid, codes, voxel_dtype)
         surface.append(met)
+        nonlocal kept
+        kept += len(met)
         if interior and len(full):
             interior_parts.setdefault(depth, []).append(full)
         return classified
 
     while stack:
         level, parents = stack.pop()
+        held -= len(parents)
         ambiguous, full, suspect, classified = classify_children(
             func, grid, level, parents, exact_voxels if level + 1 == depth else exact, mean_value,
             level_dtype(grid, level + 1) if single else np.float64, full=interior,
             recheck=recheck)
         if full is not None and len(full):
             interior_parts.setdefault(level + 1, []).append(full)
+            held += len(full)
         if len(suspect):   # rechecked in batches, for full-sized evaluations
             suspects.append(suspect)
             pending += len(suspect)
@@ -437,9 +447,13 @@ def subdivide(func: Function, grid: Grid, *, start: Optional[tuple[int, np.ndarr
         meter.done += classified
         if level + 1 == depth:
             surface.append(ambiguous)
+            kept += len(ambiguous)
         elif len(ambiguous):
             stack.extend((level + 1, ambiguous[s:s + per_step])
                          for s in range(0, len(ambiguous), per_step))
+            held += len(ambiguous)
+        if guard is not None:
+            guard.check(kept + pending, held)
         meter.report(stack)
     if suspects:
         evaluated += settle_suspects()

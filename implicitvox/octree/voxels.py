@@ -41,8 +41,10 @@ class VoxelSource(Protocol):
     """
 
     def refine(self, voxels: "Voxels", levels: int,
-               progress: Optional[Callable[[float], Any]] = None) -> "Voxels":
-        """``voxels`` continued ``levels`` levels deeper, on ``voxels.grid.finer(levels)``."""
+               progress: Optional[Callable[[float], Any]] = None,
+               max_memory: Optional[int] = None) -> "Voxels":
+        """``voxels`` continued ``levels`` levels deeper, on ``voxels.grid.finer(levels)``,
+        refused (``MemoryError``) over ``max_memory`` as the voxelizer's first run."""
 
     def normals_at(self, points: np.ndarray) -> np.ndarray:
         """Unit normals ``(n, 3)`` of the source near ``points`` (for shading)."""
@@ -169,7 +171,8 @@ class Voxels:
         return dense
 
     # -- continuing -------------------------------------------------------------------
-    def refine(self, levels: int = 1, progress: Any = None) -> "Voxels":
+    def refine(self, levels: int = 1, progress: Any = None,
+               max_memory: Optional[int] = None) -> "Voxels":
         """Continue the subdivision ``levels`` more levels (Stolte §1: "continued
         from that point").
 
@@ -179,11 +182,16 @@ class Voxels:
         ``voxelize(shape, bounds=self.bounds, voxel_size=self.voxel_size[0] / 2**levels)``
         with the same options.
 
+        ``max_memory`` bounds the run as in :func:`implicitvox.voxelize`
+        (default: half the memory available).
+
         Raises
         ------
         ValueError
             If ``levels`` is not a positive int, the result would exceed the
             octree's 21 levels, or the voxels were read from a file (no source).
+        MemoryError
+            When the estimate, or the run itself, exceeds ``max_memory``.
         """
         levels = _validate.positive_int(levels, "levels")
         if self.grid.depth + levels > 21:
@@ -192,7 +200,7 @@ class Voxels:
         if self.source is None:
             raise ValueError("refine needs the shape: these voxels were loaded from a file; "
                              "voxelize the shape again at the finer resolution")
-        return self.source.refine(self, levels, progress)
+        return self.source.refine(self, levels, progress, max_memory)
 
     # -- outputs ------------------------------------------------------------------------
     def to_pyvista(self, kind: str = "points"):

@@ -26,7 +26,8 @@ from ..octree.grid import Grid
 from ..octree.store import Octree
 from ..octree.voxels import Voxels
 from .implicit import grid_of
-from .mesh import nearest_triangle_normals
+from .memory import memory_budget, refuse_over_budget
+from .mesh import estimate_mesh_memory, nearest_triangle_normals
 
 __all__ = ["voxelize_bezier", "BezierSource"]
 
@@ -39,9 +40,11 @@ class BezierSource:
         self.patches = patches
         self.flatness = flatness
 
-    def refine(self, voxels: Voxels, levels: int, progress: Any = None) -> Voxels:
+    def refine(self, voxels: Voxels, levels: int, progress: Any = None,
+               max_memory: Optional[int] = None) -> Voxels:
         """The patches voxelized on ``voxels.grid.finer(levels)`` (the same edges)."""
-        return _voxelize_on(self, voxels.grid.finer(levels), progress, dict(voxels.metadata))
+        return _voxelize_on(self, voxels.grid.finer(levels), progress, dict(voxels.metadata),
+                            memory_budget(max_memory))
 
     def normals_at(self, points: np.ndarray) -> np.ndarray:
         """Unit normals at ``points`` of the nearest flat piece of the patches (for shading)."""
@@ -58,7 +61,8 @@ def voxelize_bezier(patches: Union[BezierPatch, Iterable[BezierPatch]],
                     bounds: Any = None,
                     voxel_size: Union[float, tuple[float, float, float], None] = None,
                     flatness: float = 0.125,
-                    progress: Optional[Callable[[float], Any]] = None) -> Voxels:
+                    progress: Optional[Callable[[float], Any]] = None,
+                    max_memory: Optional[int] = None) -> Voxels:
     """Voxelize Bézier patches: every voxel a patch meets is output (Stolte §4.2).
 
     Parameters
@@ -77,11 +81,16 @@ def voxelize_bezier(patches: Union[BezierPatch, Iterable[BezierPatch]],
         output too (smaller: tighter, more splitting).
     progress : callable, optional
         Called with the share of the work done (0 to 1).
+    max_memory : int, optional
+        Refuse (``MemoryError``) before voxelizing when the estimated peak
+        (from the flat pieces' area) exceeds this many bytes; default half the
+        available memory.
 
     Returns
     -------
     Voxels
     """
+    budget = memory_budget(max_memory)
     if isinstance(patches, BezierPatch):
         patches = [patches]
     patches = list(patches)
@@ -97,12 +106,15 @@ def voxelize_bezier(patches: Union[BezierPatch, Iterable[BezierPatch]],
         own = (tuple(nets.min(0).tolist()), tuple(nets.max(0).tolist()))
     grid = grid_of(own, bounds, resolution, voxel_size, "the patches")
     metadata = {"model": f"{len(patches)} Bezier patches", "flatness": flatness}
-    return _voxelize_on(BezierSource(patches, flatness), grid, progress, metadata)
+    return _voxelize_on(BezierSource(patches, flatness), grid, progress, metadata, budget)
 
 
-def _voxelize_on(source: BezierSource, grid: Grid, progress: Any, metadata: dict) -> Voxels:
+def _voxelize_on(source: BezierSource, grid: Grid, progress: Any, metadata: dict,
+                 budget: int) -> Voxels:
     t0 = time.perf_counter()
     tri, dil = bezier_triangles(source.patches, source.flatness * np.asarray(grid.voxel_size))
+    refuse_over_budget(estimate_mesh_memory(tri, grid, False), budget,
+                       f"voxelizing the patches at {grid.shape}")
     codes = surface_codes(Triangles(tri, dil), grid, progress=progress)
     tree = Octree.from_codes(codes, grid.depth, {}, presorted=True)
     metadata = dict(metadata, seconds_total=time.perf_counter() - t0)

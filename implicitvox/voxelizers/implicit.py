@@ -12,28 +12,38 @@ Examples
 from __future__ import annotations
 
 import time
+import warnings
 from typing import Any, Callable, Optional, Union
 
 import numpy as np
 
+from .. import _batches as batches
 from .. import _validate
 from .._version import __version__
 from ..eval.function import Function
 from ..expr.shape import as_shape, exact_classifier, voxel_classifier
 from ..octree import morton
 from ..octree.grid import Grid, padded_bounds
+from ..octree.guard import MemoryGuard
 from ..octree.store import Octree
 from ..octree.subdivide import RECHECK, subdivide
 from ..octree.voxels import Voxels
 from .memory import memory_budget, refuse_over_budget
 from .. import _batches as batches
 
-__all__ = ["voxelize", "estimate_memory", "grid_of", "ImplicitSource", "voxel_normals"]
+__all__ = ["voxelize", "estimate_memory", "bytes_per_voxel", "grid_of", "ImplicitSource",
+           "voxel_normals"]
 
 #: bytes per surface voxel while collecting and building (coords, codes, sort, tree)
 _BYTES_PER_VOXEL = 48
 _BYTES_PER_NORMAL = 24
 _PILOT_DEPTH = 6
+#: bytes of working interval arrays per box in a chunk (a few dozen float64 registers)
+_BYTES_PER_BOX = 512
+#: a run whose surface voxels are at least this share of a grid of at least
+#: USELESS_MIN_CELLS voxels is flagged with a warning
+USELESS_SHARE = 0.5
+USELESS_MIN_CELLS = 4096
 #: voxels whose normals are computed per pass
 _NORMALS_CHUNK = batches.NORMALS
 
@@ -71,10 +81,22 @@ def estimate_memory(func: Function, grid: Grid, normals: bool = False) -> tuple[
     # The pilot's voxels are unions of grid voxels; crop effects are ignored.
     # No recheck: the pilot is cheaper and its count an upper estimate.
     found = len(subdivide(func, pilot, recheck=0.0).codes)
-    voxels = found * 4 ** (depth - pilot_depth)
-    per_voxel = _BYTES_PER_VOXEL + (_BYTES_PER_NORMAL if normals else 0)
-    working = 8 * (1 << 17) * max(depth, 1) * 64  # chunks on the stack, interval arrays
-    return int(voxels), int(voxels * per_voxel + working)
+    cells = int(np.prod(grid.shape, dtype=np.float64))
+    voxels = min(found * 4 ** (depth - pilot_depth), cells)
+    return int(voxels), int(voxels * bytes_per_voxel(normals) + working_bytes(grid))
+
+
+def working_bytes(grid: Grid) -> int:
+    """The subdivision's working arrays: one chunk of boxes in flight (a small grid
+    has small chunks, so a small job is never refused under a small budget)."""
+    cells = int(np.prod(grid.shape, dtype=np.float64))
+    return min(batches.FRONTIER, cells) * _BYTES_PER_BOX
+
+
+def bytes_per_voxel(normals: bool) -> int:
+    """Peak bytes per kept surface voxel: collecting, sorting and building the tree,
+    and the normals when stored."""
+    return _BYTES_PER_VOXEL + (_BYTES_PER_NORMAL if normals else 0)
 
 
 def voxel_normals(func: Function, grid: Grid, coords: np.ndarray) -> np.ndarray:
@@ -99,13 +121,14 @@ class ImplicitSource:
         self.func = func
         self.options = dict(options)
 
-    def refine(self, voxels: Voxels, levels: int, progress: Any = None) -> Voxels:
+    def refine(self, voxels: Voxels, levels: int, progress: Any = None,
+               max_memory: Optional[int] = None) -> Voxels:
         """Continue from the stored surface voxels (the AMBIGUOUS octants at the
-        old depth) on ``voxels.grid.finer(levels)``."""
+        old depth) on ``voxels.grid.finer(levels)``, under the memory budget."""
         grid = voxels.grid.finer(levels)
         coords = voxels.coords().astype(np.int32)
         return _run(self, grid, progress, start=(voxels.grid.depth, coords),
-                    interior_before=voxels.interior)
+                    interior_before=voxels.interior, budget=memory_budget(max_memory))
 
     def normals_at(self, points: np.ndarray) -> np.ndarray:
         """Unit gradients of the shape's function at ``points`` (n, 3)."""
@@ -192,20 +215,24 @@ def voxelize(shape: Any, resolution: Union[int, tuple[int, int, int], None] = No
         raise ValueError(f"resolution {grid.shape} with subvoxel={subvoxel} exceeds the octree's "
                          "21 levels")
     func = Function(shape.expr)
-    estimated_voxels, estimated_bytes = estimate_memory(func, grid, normals)
-    refuse_over_budget(estimated_bytes, budget, f"voxelizing at {grid.shape} "
-                       f"(~{estimated_voxels:,} surface voxels)")
     return _run(ImplicitSource(shape, func, options), grid, progress, start=None,
-                interior_before=None, estimated_voxels=estimated_voxels)
+                interior_before=None, budget=budget)
 
 
 def _run(source: ImplicitSource, grid: Grid, progress, start, interior_before,
-         estimated_voxels=None) -> Voxels:
-    t0 = time.perf_counter()
+         budget: int) -> Voxels:
+    """Estimate, refuse over the budget, then subdivide under a guard of the same budget."""
     shape, func, options = source.shape, source.func, source.options
+    estimated_voxels, estimated_bytes = estimate_memory(func, grid, options["normals"])
+    what = f"voxelizing at {grid.shape}"
+    refuse_over_budget(estimated_bytes, budget, f"{what} (~{estimated_voxels:,} surface voxels)")
+    guard = MemoryGuard(budget, what, bytes_per_voxel(options["normals"]),
+                        estimated_voxels=estimated_voxels, working=working_bytes(grid))
+    t0 = time.perf_counter()
     result = _subdivide(func, grid, options, (exact_classifier(shape), voxel_classifier(shape)),
-                        progress, start)
+                        progress, start, guard)
     t1 = time.perf_counter()
+    _warn_if_useless(len(result.codes), grid)
     payload = {}
     if options["normals"]:
         payload["normals"] = voxel_normals(func, grid, result.surface)
@@ -218,20 +245,32 @@ def _run(source: ImplicitSource, grid: Grid, progress, start, interior_before,
         "seconds_subdivide": t1 - t0,
         "seconds_total": time.perf_counter() - t0,
         "boxes_evaluated": result.evaluated,
-        "estimated_voxels": estimated_voxels if estimated_voxels is not None else -1,
+        "estimated_voxels": estimated_voxels,
         "implicitvox": __version__,
     }
     return Voxels(grid, tree, interior, metadata, source=source)
 
 
-def _subdivide(func, grid, options, exact, progress, start):
+def _warn_if_useless(count: int, grid: Grid) -> None:
+    """Warn when the surface voxels are most of the grid: the intervals could not
+    tell inside from outside, and the voxels say little about the shape."""
+    cells = int(np.prod(grid.shape, dtype=np.float64))
+    if cells >= USELESS_MIN_CELLS and count >= USELESS_SHARE * cells:
+        warnings.warn(f"{count:,} of the grid's {cells:,} voxels ({count / cells:.0%}) are "
+                      "surface voxels: interval arithmetic could not separate inside from "
+                      "outside (detail finer than a voxel, catastrophic cancellation, or a "
+                      "scale below the float resolution); check the model's scale or the "
+                      "resolution", UserWarning, stacklevel=4)
+
+
+def _subdivide(func, grid, options, exact, progress, start, guard):
     """Subdivide on the grid, or on a finer one mapped back (``subvoxel``)."""
     s = options["subvoxel"]
     exact_boxes, exact_voxels = exact
     result = subdivide(func, grid.finer(s) if s else grid, start=start,
                        interior=options["interior"], exact=exact_boxes, progress=progress,
                        mean_value=options["mean_value"], exact_voxels=exact_voxels,
-                       recheck=options["recheck"])
+                       recheck=options["recheck"], guard=guard)
     if not s:
         return result
     result.codes = np.unique(result.codes >> np.uint64(3 * s))   # the voxels holding them

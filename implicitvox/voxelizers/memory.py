@@ -14,7 +14,7 @@ True
 """
 from __future__ import annotations
 
-from typing import Any
+from typing import Any, Optional
 
 from .. import _validate
 
@@ -22,7 +22,24 @@ __all__ = ["memory_budget", "available_memory", "refuse_over_budget"]
 
 
 def available_memory() -> int:
-    """Bytes available now (Linux ``MemAvailable``), else 16 GiB."""
+    """Bytes this process may still use now: the least of the machine's available
+    memory (Linux ``MemAvailable``), what its cgroup allows beyond its current use
+    (``memory.max``, v2 or v1), and its address-space limit (``RLIMIT_AS``) beyond
+    its current size; 16 GiB where none of them can be read."""
+    limits = [v for v in (_meminfo_available(), _cgroup_room(), _rlimit_room()) if v is not None]
+    return max(0, min(limits)) if limits else 16 << 30
+
+
+def _read_int(path: str) -> Optional[int]:
+    try:
+        with open(path) as fh:
+            text = fh.read().strip()
+    except OSError:
+        return None
+    return int(text) if text.isdigit() else None
+
+
+def _meminfo_available() -> Optional[int]:
     try:
         with open("/proc/meminfo") as fh:
             for line in fh:
@@ -30,7 +47,36 @@ def available_memory() -> int:
                     return int(line.split()[1]) * 1024
     except (OSError, ValueError, IndexError):
         pass
-    return 16 << 30
+    return None
+
+
+def _cgroup_room() -> Optional[int]:
+    for limit, usage in (("/sys/fs/cgroup/memory.max", "/sys/fs/cgroup/memory.current"),
+                         ("/sys/fs/cgroup/memory/memory.limit_in_bytes",
+                          "/sys/fs/cgroup/memory/memory.usage_in_bytes")):
+        cap = _read_int(limit)             # "max" (no limit) reads as None
+        if cap is not None and cap < 1 << 60:
+            return cap - (_read_int(usage) or 0)
+    return None
+
+
+def _rlimit_room() -> Optional[int]:
+    try:
+        import resource
+        soft, _ = resource.getrlimit(resource.RLIMIT_AS)
+    except (ImportError, ValueError, OSError):
+        return None
+    if soft == resource.RLIM_INFINITY or soft < 0:
+        return None
+    size = 0
+    try:
+        with open("/proc/self/status") as fh:
+            for line in fh:
+                if line.startswith("VmSize:"):
+                    size = int(line.split()[1]) * 1024
+    except (OSError, ValueError, IndexError):
+        pass
+    return soft - size
 
 
 def memory_budget(max_memory: Any) -> int:

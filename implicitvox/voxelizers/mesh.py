@@ -50,10 +50,11 @@ class MeshSource:
         self.name = name
         self.interior = interior
 
-    def refine(self, voxels: Voxels, levels: int, progress: Any = None) -> Voxels:
+    def refine(self, voxels: Voxels, levels: int, progress: Any = None,
+               max_memory: Optional[int] = None) -> Voxels:
         """The mesh voxelized on ``voxels.grid.finer(levels)`` (the same edges)."""
-        grid = voxels.grid.finer(levels)
-        return _voxelize_on(self, grid, progress, dict(voxels.metadata))
+        return _voxelize_on(self, voxels.grid.finer(levels), progress, dict(voxels.metadata),
+                            memory_budget(max_memory))
 
     def normals_at(self, points: np.ndarray) -> np.ndarray:
         """Unit normals ``(n, 3)`` of the triangles nearest to ``points`` (for shading)."""
@@ -141,16 +142,16 @@ def voxelize_mesh(mesh: Any, resolution: Union[int, tuple[int, int, int], None] 
         raise ValueError("the mesh has no triangles: pass bounds to get an empty voxelization")
     own = mesh_bounds(vertices, faces) if bounds is None else None
     grid = grid_of(own, bounds, resolution, voxel_size, "the mesh")
-    triangles = vertices[faces]
-    refuse_over_budget(estimate_mesh_memory(triangles, grid, interior), budget,
-                       f"voxelizing the mesh at {grid.shape}")
     name = os.fspath(mesh) if isinstance(mesh, (str, os.PathLike)) else type(mesh).__name__
-    source = MeshSource(Triangles(triangles), name, interior)
+    source = MeshSource(Triangles(vertices[faces]), name, interior)
     metadata = {"model": f"mesh {name}: {len(vertices)} vertices, {len(faces)} triangles"}
-    return _voxelize_on(source, grid, progress, metadata)
+    return _voxelize_on(source, grid, progress, metadata, budget)
 
 
-def _voxelize_on(source: MeshSource, grid: Grid, progress: Any, metadata: dict) -> Voxels:
+def _voxelize_on(source: MeshSource, grid: Grid, progress: Any, metadata: dict,
+                 budget: int) -> Voxels:
+    refuse_over_budget(estimate_mesh_memory(source.triangles.v, grid, source.interior), budget,
+                       f"voxelizing the mesh at {grid.shape}")
     t0 = time.perf_counter()
     codes = surface_codes(source.triangles, grid, progress=progress)
     t1 = time.perf_counter()

@@ -1,0 +1,65 @@
+"""Memory: estimated before a run, guarded during it, limited by the process's own limits."""
+from __future__ import annotations
+
+import subprocess
+import sys
+import textwrap
+import warnings
+
+import pytest
+
+import implicitvox as ivx
+from implicitvox import sin, x, y, z
+from implicitvox.eval.function import Function
+from implicitvox.octree.grid import Grid
+from implicitvox.voxelizers.implicit import estimate_memory
+
+CUBE = ((-1.0,) * 3, (1.0,) * 3)
+#: a surface that fills space: it grows x8 per level, the estimate assumes x4
+WIGGLY = sin(100 * x) * sin(100 * y) * sin(100 * z)
+
+
+def test_a_run_that_beats_its_estimate_stops_at_the_budget():
+    _, estimated = estimate_memory(Function(WIGGLY), Grid.from_bounds(CUBE, 128))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", UserWarning)
+        with pytest.raises(MemoryError, match="stopped after .* surface voxels .the estimate "
+                                              "said ~1,048,576.*over the budget"):
+            ivx.voxelize(WIGGLY, 128, bounds=CUBE, max_memory=int(estimated * 1.1))
+        # with room for what it really keeps, the same run completes
+        vox = ivx.voxelize(WIGGLY, 128, bounds=CUBE, max_memory=int(estimated * 2))
+    assert vox.count > 1_048_576 * 1.5
+
+
+def test_small_jobs_pass_under_a_small_budget():
+    vox = ivx.voxelize(x * x + y * y + z * z - 0.5, 16, bounds=CUBE, max_memory=4 << 20)
+    assert vox.count > 0
+
+
+def test_refine_is_estimated_and_guarded_too():
+    coarse = ivx.voxelize(x * x + y * y + z * z - 0.5, 16, bounds=CUBE)
+    with pytest.raises(MemoryError, match="over the budget"):
+        coarse.refine(4, max_memory=1 << 20)
+    import pyvista as pv
+    mesh = ivx.voxelize_mesh(pv.Sphere(), 16)
+    with pytest.raises(MemoryError, match="over the budget"):
+        mesh.refine(4, max_memory=1 << 16)
+
+
+def test_the_default_budget_respects_the_address_space_limit():
+    code = textwrap.dedent("""
+        import resource
+        resource.setrlimit(resource.RLIMIT_AS, (3 << 30, resource.RLIM_INFINITY))
+        from implicitvox.voxelizers.memory import available_memory, memory_budget
+        print(available_memory() <= 3 << 30, memory_budget(None) <= 3 << 29)
+        """)
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
+    assert out.stdout.split() == ["True", "True"], out.stderr
+
+
+def test_a_surface_that_fills_the_grid_is_flagged():
+    with pytest.warns(UserWarning, match="interval arithmetic could not separate"):
+        ivx.voxelize(sin(60 * x) * sin(60 * y) * sin(60 * z), 32, bounds=CUBE)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", UserWarning)
+        ivx.voxelize(x * x + y * y + z * z - 0.5, 32, bounds=CUBE)   # a plain sphere is not
