@@ -168,7 +168,7 @@ class _Builder:
             return handler(node)
         except OpenSCADError:
             raise
-        except ValueError as err:         # a primitive refused its parameters
+        except (ValueError, TypeError, ArithmeticError) as err:   # refused parameters
             raise self.error(node, f"{node.name}: {err}") from None
 
     def children(self, node: Node) -> list[Solid]:

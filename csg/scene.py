@@ -98,8 +98,12 @@ def load_json(text_or_path: Any) -> Solid:
             raise FileNotFoundError(f"no such scene file: {path}")
         if os.path.getsize(path) > LIMITS["text_bytes"]:
             raise SceneError(f"{path}: larger than {LIMITS['text_bytes']} bytes")
-        with open(path, encoding="utf-8") as fh:
-            text = fh.read()
+        try:
+            with open(path, encoding="utf-8") as fh:
+                text = fh.read()
+        except UnicodeDecodeError as err:
+            raise SceneError(f"{path}: not UTF-8 text ({err.reason} at byte {err.start})") \
+                from None
     if len(text) > LIMITS["text_bytes"]:
         raise SceneError(f"scene larger than {LIMITS['text_bytes']} bytes")
     try:
@@ -139,14 +143,15 @@ class _Reader:
         if not isinstance(node, dict):
             raise SceneError(f"{path}: a node must be an object, got {type(node).__name__}")
         kind = node.get("type")
-        reader = getattr(self, f"_{kind}") if kind in NODE_TYPES else None
+        reader = getattr(self, f"_{kind}") if isinstance(kind, str) and kind in NODE_TYPES \
+            else None
         if reader is None:
             raise SceneError(f"{path}.type: unknown node type {kind!r}")
         try:
             return reader(node, path, depth)
         except SceneError:
             raise
-        except (ValueError, TypeError) as err:
+        except (ValueError, TypeError, ArithmeticError) as err:
             raise SceneError(f"{path}: {err}") from None
 
     # field readers

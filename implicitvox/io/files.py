@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import json
 import os
+import re
 from typing import Any
 
 import numpy as np
@@ -56,7 +57,14 @@ def load(path: str) -> Voxels:
     ext = _suffix(path)
     if not os.path.isfile(path):
         raise FileNotFoundError(f"no such voxel file: {path!r}")
-    return {".npz": _load_npz, ".vti": _load_vti, ".binvox": _load_binvox}[ext](str(path))
+    reader = {".npz": _load_npz, ".vti": _load_vti, ".binvox": _load_binvox}[ext]
+    try:
+        return reader(str(path))
+    except (ValueError, MemoryError, FileNotFoundError):
+        raise
+    except Exception as err:  # noqa: BLE001 - hostile bytes: one documented error type
+        raise ValueError(f"{path!r}: cannot read it as {ext}: {type(err).__name__}: "
+                         f"{str(err)[:200]}") from None
 
 
 # -- npz ------------------------------------------------------------------------------
@@ -186,11 +194,22 @@ def _save_vti(vox: Voxels, path: str) -> None:
 
 def _load_vti(path: str) -> Voxels:
     import pyvista as pv
+    _check_vti_extent(path)
     image = pv.read(path)
-    if "surface" not in image.cell_data:
+    if not isinstance(image, pv.ImageData) or "surface" not in image.cell_data:
         raise ValueError(f"{path!r} has no 'surface' cell array (not written by implicitvox)")
     shape = tuple(int(d) - 1 for d in image.dimensions)
-    grid = Grid(tuple(image.origin), tuple(image.spacing), shape)
+    origin, spacing = np.asarray(image.origin, float), np.asarray(image.spacing, float)
+    if not all(1 <= n <= MAX_RESOLUTION for n in shape):
+        raise ValueError(f"{path!r}: field 'WholeExtent' gives {shape} cells (1 to "
+                         f"{MAX_RESOLUTION} per axis)")
+    if not (np.all(np.isfinite(origin)) and np.all(np.isfinite(spacing)) and np.all(spacing > 0)):
+        raise ValueError(f"{path!r}: fields 'Origin' and 'Spacing' must be finite, the spacing "
+                         f"positive, got {origin.tolist()}, {spacing.tolist()}")
+    if image.cell_data["surface"].size != int(np.prod(shape)):
+        raise ValueError(f"{path!r}: field 'surface' has {image.cell_data['surface'].size} "
+                         f"values for {shape} cells")
+    grid = Grid(tuple(origin.tolist()), tuple(spacing.tolist()), shape)
     surface = np.asarray(image.cell_data["surface"]).reshape(shape, order="F").astype(bool)
     interior = {}
     if "interior" in image.cell_data:
@@ -198,6 +217,27 @@ def _load_vti(path: str) -> Voxels:
         interior = {grid.depth: np.argwhere(inside).astype(np.int32)}
     tree = Octree.from_coords(np.argwhere(surface), grid.depth)
     return Voxels(grid, tree, interior, {"source": os.path.basename(path)})
+
+
+def _check_vti_extent(path: str) -> None:
+    """The image's declared extent, bounded before VTK allocates it."""
+    with open(path, "rb") as fh:
+        head = fh.read(1 << 14)
+    m = re.search(rb'WholeExtent\s*=\s*"([^"]{0,200})"', head)
+    if m is None:
+        raise ValueError(f"{path!r}: no ImageData 'WholeExtent' in its header (not a .vti file)")
+    try:
+        ext = [int(v) for v in m.group(1).split()]
+    except ValueError:
+        raise ValueError(f"{path!r}: field 'WholeExtent' is {m.group(1)[:60]!r}") from None
+    if len(ext) != 6:
+        raise ValueError(f"{path!r}: field 'WholeExtent' must hold 6 ints, got {len(ext)}")
+    cells = 1
+    for lo, hi in zip(ext[0::2], ext[1::2]):
+        cells *= max(hi - lo, 0)
+    if cells > BINVOX_LIMIT:
+        raise ValueError(f"{path!r}: field 'WholeExtent' declares {cells:,} cells, over the "
+                         f"limit of {BINVOX_LIMIT:,} (implicitvox.io.files.BINVOX_LIMIT)")
 
 
 # -- binvox --------------------------------------------------------------------------

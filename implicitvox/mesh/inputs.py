@@ -28,6 +28,7 @@ from typing import Any
 import numpy as np
 
 from .declared import check_declared_sizes
+from .isolated import run_isolated
 
 __all__ = ["as_triangles", "MESH_SUFFIXES"]
 
@@ -38,7 +39,9 @@ MESH_SUFFIXES = (".stl", ".ply", ".obj", ".vtk", ".vtp")
 def as_triangles(mesh: Any) -> tuple[np.ndarray, np.ndarray]:
     """``(vertices (v, 3) float64, faces (f, 3) int64)`` from any accepted mesh input."""
     if isinstance(mesh, (str, os.PathLike)):
-        return _from_pyvista(_read(os.fspath(mesh)), f"file {os.fspath(mesh)!r}")
+        path = os.fspath(mesh)
+        # VTK's readers may crash on a corrupt file: they run in a child process
+        return run_isolated(_file_triangles, path, where=f"cannot read {path!r}")
     if _is_pyvista(mesh):
         return _from_pyvista(mesh, type(mesh).__name__)
     if _is_trimesh(mesh):
@@ -47,6 +50,10 @@ def as_triangles(mesh: Any) -> tuple[np.ndarray, np.ndarray]:
         return _check(*mesh)
     raise TypeError("mesh must be (vertices, faces) arrays, a PyVista mesh, a trimesh.Trimesh "
                     f"or a path to {'/'.join(MESH_SUFFIXES)}, got {type(mesh).__name__}")
+
+
+def _file_triangles(path: str) -> tuple[np.ndarray, np.ndarray]:
+    return _from_pyvista(_read(path), f"file {path!r}")
 
 
 def _is_trimesh(mesh: Any) -> bool:
