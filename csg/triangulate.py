@@ -13,11 +13,24 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["triangulate"]
+__all__ = ["triangulate", "MAX_POLYGON_POINTS"]
+
+#: points per polygon at most: ear clipping here is quadratic in Python (4,000 points take
+#: about 15 s); beyond, a C++ triangulator (mapbox-earcut) would be the way
+MAX_POLYGON_POINTS = 4000
 
 
 def triangulate(poly: np.ndarray) -> list[tuple[int, int, int]]:
-    """Ear clipping of a simple polygon (counter-clockwise), vertex indices."""
+    """Ear clipping of a simple polygon (counter-clockwise), vertex indices.
+
+    Raises
+    ------
+    ValueError
+        For a polygon that is not simple, or of more than :data:`MAX_POLYGON_POINTS`.
+    """
+    if len(poly) > MAX_POLYGON_POINTS:
+        raise ValueError(f"a polygon of {len(poly):,} points is over the limit of "
+                         f"{MAX_POLYGON_POINTS:,} (csg.triangulate.MAX_POLYGON_POINTS)")
     idx = list(range(len(poly)))
     out = []
     guard = 0

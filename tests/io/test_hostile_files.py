@@ -197,3 +197,26 @@ def test_refine_beyond_the_octree_is_refused_at_once():
             print("refused:", err)
         """)
     assert out.returncode == 0 and "exceeds the octree's 21 levels" in out.stdout
+
+
+def test_polygons_are_bounded():
+    pts = ",".join(f"[{i},{(i * 7) % 13}]" for i in range(5000))
+    with pytest.raises(OpenSCADError, match="over the limit of 4,000"):
+        read_openscad(f"linear_extrude(height = 1) polygon(points = [{pts}]);")
+
+
+@pytest.mark.parametrize("option", [{"mean_value": "no"}, {"interior": 1}, {"normals": "yes"},
+                                    {"recheck": True}, {"subvoxel": 1.0}])
+def test_option_types_are_strict(option):
+    with pytest.raises(ValueError, match=next(iter(option))):
+        ivx.voxelize(ivx.x ** 2 + ivx.y ** 2 + ivx.z ** 2 - 1, 8, bounds=((-2,) * 3, (2,) * 3),
+                     **option)
+
+
+def test_the_command_line_says_which_files_run_code(capsys):
+    from implicitvox.io.cli import main
+    with pytest.raises(SystemExit):
+        main(["--help"])
+    out = " ".join(capsys.readouterr().out.split())
+    assert "A .py model file is Python and is executed" in out
+    assert "read as data" in out
