@@ -44,6 +44,13 @@ def _point(value: Any, name: str) -> np.ndarray:
     return vector(value, name, planar=False, scalar=True)
 
 
+def _similarity(matrix: np.ndarray) -> tuple[np.ndarray, np.ndarray, Optional[float]]:
+    """The linear part, the offset and the scale of an affine map (None if it is not a
+    rotation times a scale)."""
+    m = matrix[:3, :3]
+    return m, matrix[:3, 3], similarity_scale(m)
+
+
 def _box(lo: Sequence[float], hi: Sequence[float]) -> Bounds:
     return tuple(float(v) for v in lo), tuple(float(v) for v in hi)
 
@@ -166,8 +173,7 @@ class Cylinder(Solid):
 
     def world_linf(self, matrix: np.ndarray) -> Optional[linf.Primitive]:
         """Exact under similarities (a frustum); None under other maps."""
-        m, t = matrix[:3, :3], matrix[:3, 3]
-        k = similarity_scale(m)
+        m, t, k = _similarity(matrix)
         if k is None:
             return None
         z0, _ = self._z
@@ -202,8 +208,7 @@ class Torus(Solid):
 
     def world_linf(self, matrix: np.ndarray) -> Optional[linf.Primitive]:
         """Exact under similarities; turned off the axes, for ring tori only."""
-        m, t = matrix[:3, :3], matrix[:3, 3]
-        k = similarity_scale(m)
+        m, t, k = _similarity(matrix)
         if k is None:
             return None
         axis = m[:, 2] / np.linalg.norm(m[:, 2])
