@@ -60,6 +60,8 @@ def test_model_errors_name_the_model_line(tmp_path, capsys, source, match):
     (["voxelize", "--example", "sphere", "--bounds", "0", "0", "0", "0", "1", "1"], "extent"),
     (["voxelize", "--example", "sinsin918", "--resolution", "8192", "--max-memory", "0.1"],
      "over the budget"),
+    (["voxelize", "--example", "sphere", "--max-memory", "inf"], "--max-memory must be a positive"),
+    (["voxelize", "--example", "sphere", "--voxel-size", "-1"], "voxel_size must be a positive"),
 ])
 def test_bad_input_is_refused_clearly(argv, match, capsys):
     code, _, err = run(argv, capsys)
