@@ -2,7 +2,10 @@
 
 Supported modules: ``group, union, difference, intersection, multmatrix,
 cube, sphere, cylinder, polyhedron, circle, square, polygon, linear_extrude,
-rotate_extrude, color, render`` with ``$fn, $fa, $fs``. Any other module
+rotate_extrude, color, render`` with ``$fn, $fa, $fs``, and OpenSCAD's
+modifiers as its ``.csg`` export writes them: ``%`` (background) and ``*``
+(disabled) drop their subtree, ``#`` (highlight) keeps it, ``!`` (root) makes
+its subtree the whole design. Any other module
 (``hull``, ``minkowski``, ``offset``, ``text``, ``import``, ``resize``, ...) is
 refused with its name, line and column. Nothing is evaluated.
 
@@ -80,11 +83,26 @@ def read_openscad(path_or_text: Any, facets: str = "true") -> Solid:
     else:
         raise TypeError(f"expected a path or .csg text, got {type(path_or_text).__name__}")
     nodes = parse(text, source)
+    root = _root_node(nodes)
+    if root is not None:                 # "!": this subtree alone is the design
+        nodes = [root]
+        root.modifiers = root.modifiers.replace("!", "")
     builder = _Builder(source, facets == "openscad")
     solids = [s for s in (builder.build(n) for n in nodes) if s is not None]
     if not solids:
         raise OpenSCADError("the file holds no geometry", 1, 1, source)
     return solids[0] if len(solids) == 1 else Union(*solids)
+
+
+def _root_node(nodes: list[Node]) -> Optional[Node]:
+    """The first node marked with OpenSCAD's root modifier ``!``, depth first, or None."""
+    stack = list(reversed(nodes))
+    while stack:
+        node = stack.pop()
+        if "!" in node.modifiers:
+            return node
+        stack.extend(reversed(node.children))
+    return None
 
 
 #: convex hulls with more faces become polyhedra (exact test, grid-indexed) instead of a
@@ -159,6 +177,8 @@ class _Builder:
 
     # -- nodes -----------------------------------------------------------------------------
     def build(self, node: Node) -> Optional[Solid]:
+        if "%" in node.modifiers or "*" in node.modifiers:
+            return None                  # background and disabled subtrees are no geometry
         handler = getattr(self, "_" + node.name, None)
         if node.name not in SUPPORTED or handler is None:
             known = "not supported" if node.name in UNSUPPORTED else "unknown"

@@ -65,6 +65,9 @@ class Node:
     children: list["Node"] = field(default_factory=list)
     line: int = 0
     column: int = 0
+    #: OpenSCAD's modifier characters before the name: ``%`` background, ``#``
+    #: highlight, ``*`` disable, ``!`` root
+    modifiers: str = ""
 
 
 _TOKEN = re.compile(r"""
@@ -73,7 +76,8 @@ _TOKEN = re.compile(r"""
     (?P<number>(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?) |
     (?P<ident>\$?[A-Za-z_][A-Za-z0-9_]*) |
     (?P<string>"(?:[^"\\\n]|\\.)*") |
-    (?P<punct>[()\[\]{},;=\-+])
+    (?P<punct>[()\[\]{},;=\-+]) |
+    (?P<modifier>[%#*!])
 """, re.VERBOSE | re.DOTALL)
 
 
@@ -154,20 +158,24 @@ class _Parser:
     def statement(self, depth: int) -> Node:
         if depth > MAX_DEPTH:
             raise self.error(f"nesting deeper than {MAX_DEPTH} levels")
+        modifiers = ""
+        while self.tok.kind == "modifier":
+            modifiers += self.tok.text
+            self.i += 1
         t = self.tok
         if t.kind != "ident":
             raise self.error(f"expected a module name, got {self.describe(t)}")
         self.i += 1
         self.expect("(", f"after module name {t.text!r}")
         args, positional = self.arguments(depth)
-        node = Node(t.text, args, positional, line=t.line, column=t.column)
+        node = Node(t.text, args, positional, line=t.line, column=t.column, modifiers=modifiers)
         nxt = self.tok
         if nxt.kind == "punct" and nxt.text == ";":
             self.i += 1
         elif nxt.kind == "punct" and nxt.text == "{":
             self.i += 1
             node.children = self.statements(depth + 1, nxt)
-        elif nxt.kind == "ident":                      # a single child without braces
+        elif nxt.kind in ("ident", "modifier"):        # a single child without braces
             node.children = [self.statement(depth + 1)]
         else:
             raise self.error(f"expected ';' or '{{' after {t.text}(...), got "

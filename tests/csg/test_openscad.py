@@ -205,3 +205,22 @@ def test_truncated_file(tmp_path):
         read_openscad(path)
     with pytest.raises(FileNotFoundError):
         read_openscad(tmp_path / "missing.csg")
+
+
+@pytest.mark.parametrize("text, bounds", [
+    ("union() { cube(size = 1); %sphere(r = 5); }", ((0, 0, 0), (1, 1, 1))),       # background
+    ("union() { cube(size = 1); *sphere(r = 5); }", ((0, 0, 0), (1, 1, 1))),       # disabled
+    ("union() { cube(size = 1); #sphere(r = 5); }", ((-5, -5, -5), (5, 5, 5))),    # highlight
+    ("union() { cube(size = 1); multmatrix([[1, 0, 0, 9], [0, 1, 0, 0], [0, 0, 1, 0], "
+     "[0, 0, 0, 1]]) !sphere(r = 0.5); }", ((-0.5,) * 3, (0.5,) * 3)),             # root
+    ("group() %#cube(size = 2); cube(size = 1);", ((0, 0, 0), (1, 1, 1))),         # combined
+])
+def test_modifiers_as_openscad_writes_them(text, bounds):
+    for facets, atol in (("true", 1e-9), ("openscad", 0.1)):     # facets: polygons inside
+        solid = read_openscad(text, facets=facets)
+        np.testing.assert_allclose(solid.bounds, bounds, atol=atol)
+
+
+def test_a_file_of_background_parts_only_has_no_geometry():
+    with pytest.raises(OpenSCADError, match="holds no geometry"):
+        read_openscad("%cube(size = 1);")
