@@ -164,7 +164,8 @@ BAD = [
     ("sphere(r = \"big\");", "r must be a finite number", (1, 1)),
     ("cube(size = [1, 2]);", "size must be 3 finite numbers", (1, 1)),
     ("cube(size = 1, size = 2);", "given twice", (1, 16)),
-    ("cube(size = 1) # ;", "unexpected character", (1, 16)),
+    ("cube(size = 1) @ ;", "unexpected character", (1, 16)),
+    ("cube(size = 1) # ;", "expected a module name, got ';'", (1, 18)),
     ("multmatrix(m = [[1, 0], [0, 1]]) cube(size = 1);", "4 x 4", (1, 1)),
 ]
 
