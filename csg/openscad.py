@@ -111,8 +111,12 @@ MAX_PLANES = 64
 
 
 def _convex(points: np.ndarray) -> Solid:
-    from scipy.spatial import ConvexHull
-    hull = ConvexHull(points)
+    from scipy.spatial import ConvexHull, QhullError
+    try:
+        hull = ConvexHull(points)
+    except QhullError as err:
+        raise ValueError(f"the facets span no volume (flat or degenerate): "
+                         f"{str(err).splitlines()[0]}") from None
     if len(hull.equations) <= MAX_PLANES:
         return ConvexPolyhedron(points=points)
     faces = hull.simplices.copy()

@@ -22,6 +22,7 @@ from typing import Any
 import numpy as np
 
 from .. import _validate
+from ..mesh.isolated import run_isolated
 from ..octree.grid import MAX_RESOLUTION, Grid
 from ..octree.store import Octree
 from ..octree.voxels import DEFAULT_DENSE_LIMIT, Voxels
@@ -193,8 +194,20 @@ def _save_vti(vox: Voxels, path: str) -> None:
 
 
 def _load_vti(path: str) -> Voxels:
+    cells = _check_vti_extent(path)
+    # VTK's XML reader may crash on a corrupt file: it runs in a child process, which
+    # may allocate what the declared cells need (a few arrays of a byte or a float each)
+    shape, origin, spacing, surface, inside = run_isolated(
+        _vti_arrays, path, where=f"cannot read {path!r}", max_bytes=(256 << 20) + 32 * cells)
+    grid = Grid(tuple(origin.tolist()), tuple(spacing.tolist()), shape)
+    interior = {} if inside is None else {grid.depth: np.argwhere(inside).astype(np.int32)}
+    tree = Octree.from_coords(np.argwhere(surface), grid.depth)
+    return Voxels(grid, tree, interior, {"source": os.path.basename(path)})
+
+
+def _vti_arrays(path: str):
+    """The image's grid and its surface and interior masks, every field checked."""
     import pyvista as pv
-    _check_vti_extent(path)
     image = pv.read(path)
     if not isinstance(image, pv.ImageData) or "surface" not in image.cell_data:
         raise ValueError(f"{path!r} has no 'surface' cell array (not written by implicitvox)")
@@ -206,21 +219,21 @@ def _load_vti(path: str) -> Voxels:
     if not (np.all(np.isfinite(origin)) and np.all(np.isfinite(spacing)) and np.all(spacing > 0)):
         raise ValueError(f"{path!r}: fields 'Origin' and 'Spacing' must be finite, the spacing "
                          f"positive, got {origin.tolist()}, {spacing.tolist()}")
-    if image.cell_data["surface"].size != int(np.prod(shape)):
-        raise ValueError(f"{path!r}: field 'surface' has {image.cell_data['surface'].size} "
-                         f"values for {shape} cells")
-    grid = Grid(tuple(origin.tolist()), tuple(spacing.tolist()), shape)
-    surface = np.asarray(image.cell_data["surface"]).reshape(shape, order="F").astype(bool)
-    interior = {}
-    if "interior" in image.cell_data:
-        inside = np.asarray(image.cell_data["interior"]).reshape(shape, order="F").astype(bool)
-        interior = {grid.depth: np.argwhere(inside).astype(np.int32)}
-    tree = Octree.from_coords(np.argwhere(surface), grid.depth)
-    return Voxels(grid, tree, interior, {"source": os.path.basename(path)})
+    masks = []
+    for name in ("surface", "interior"):
+        if name not in image.cell_data:
+            masks.append(None)
+            continue
+        values = np.asarray(image.cell_data[name])
+        if values.size != int(np.prod(shape)):
+            raise ValueError(f"{path!r}: field {name!r} has {values.size} values for {shape} "
+                             "cells")
+        masks.append(values.reshape(shape, order="F").astype(bool))
+    return shape, origin, spacing, masks[0], masks[1]
 
 
-def _check_vti_extent(path: str) -> None:
-    """The image's declared extent, bounded before VTK allocates it."""
+def _check_vti_extent(path: str) -> int:
+    """The image's declared cells, bounded before VTK allocates them."""
     with open(path, "rb") as fh:
         head = fh.read(1 << 14)
     m = re.search(rb'WholeExtent\s*=\s*"([^"]{0,200})"', head)
@@ -238,6 +251,7 @@ def _check_vti_extent(path: str) -> None:
     if cells > BINVOX_LIMIT:
         raise ValueError(f"{path!r}: field 'WholeExtent' declares {cells:,} cells, over the "
                          f"limit of {BINVOX_LIMIT:,} (implicitvox.io.files.BINVOX_LIMIT)")
+    return cells
 
 
 # -- binvox --------------------------------------------------------------------------

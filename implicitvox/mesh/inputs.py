@@ -41,7 +41,9 @@ def as_triangles(mesh: Any) -> tuple[np.ndarray, np.ndarray]:
     if isinstance(mesh, (str, os.PathLike)):
         path = os.fspath(mesh)
         # VTK's readers may crash on a corrupt file: they run in a child process
-        return run_isolated(_file_triangles, path, where=f"cannot read {path!r}")
+        size = os.path.getsize(path) if os.path.isfile(path) else 0
+        return run_isolated(_file_triangles, path, where=f"cannot read {path!r}",
+                            max_bytes=(512 << 20) + 64 * size)
     if _is_pyvista(mesh):
         return _from_pyvista(mesh, type(mesh).__name__)
     if _is_trimesh(mesh):

@@ -9,6 +9,7 @@ crash would show as a signal.
 from __future__ import annotations
 
 import json
+import re
 import struct
 import subprocess
 import sys
@@ -220,3 +221,36 @@ def test_the_command_line_says_which_files_run_code(capsys):
     out = " ".join(capsys.readouterr().out.split())
     assert "A .py model file is Python and is executed" in out
     assert "read as data" in out
+
+
+def test_a_vti_whose_arrays_lie_is_refused_not_a_crash(saved, tmp_path):
+    """A corrupt data array that makes VTK's XML reader allocate without end (the long
+    fuzz run found such mutants: std::bad_alloc, SIGABRT) ends in a ValueError."""
+    vox = saved[0]
+    path = tmp_path / "v.vti"
+    vox.save(str(path))
+    data = path.read_bytes()
+    m = re.search(rb'NumberOfComponents="1"', data)
+    bad = data.replace(b'NumberOfComponents="1"', b'NumberOfComponents="999999999"', 1) \
+        if m else data[:len(data) // 2]
+    path.write_bytes(bad)
+    out = _run_isolated(f"""
+        import implicitvox as iv
+        try:
+            iv.load({str(path)!r})
+            print("loaded")
+        except ValueError as err:
+            print("refused:", str(err)[:200])
+        """, timeout=120)
+    assert out.returncode == 0 and ("refused:" in out.stdout), (out.stdout, out.stderr[-300:])
+
+
+
+@pytest.mark.parametrize("text", [
+    "cylinder($fn = 24, $fa = 12, $fs = 2, h = 20, r1 = 99999999999999999999, r2 = 3);",
+    "sphere($fn = 0, $fa = 12, $fs = 2, r = 1e-320);",
+])
+def test_degenerate_facets_are_refused_with_their_location(text):
+    """Found by the long fuzz run: Qhull's error escaped as a QhullError."""
+    with pytest.raises(OpenSCADError, match="1:1: .*the facets span no volume"):
+        read_openscad(text, facets="openscad")
