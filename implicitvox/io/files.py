@@ -195,6 +195,7 @@ def _save_vti(vox: Voxels, path: str) -> None:
 
 def _load_vti(path: str) -> Voxels:
     cells = _check_vti_extent(path)
+    import pyvista  # noqa: F401 - imported once here, not again in every child
     # VTK's XML reader may crash on a corrupt file: it runs in a child process, which
     # may allocate what the declared cells need (a few arrays of a byte or a float each)
     shape, origin, spacing, surface, inside = run_isolated(

@@ -42,6 +42,7 @@ def as_triangles(mesh: Any) -> tuple[np.ndarray, np.ndarray]:
         path = os.fspath(mesh)
         # VTK's readers may crash on a corrupt file: they run in a child process
         size = os.path.getsize(path) if os.path.isfile(path) else 0
+        import pyvista  # noqa: F401 - imported once here, not again in every child
         return run_isolated(_file_triangles, path, where=f"cannot read {path!r}",
                             max_bytes=(512 << 20) + 64 * size)
     if _is_pyvista(mesh):
