@@ -29,7 +29,6 @@ from ..octree.store import Octree
 from ..octree.subdivide import RECHECK, subdivide
 from ..octree.voxels import Voxels
 from .memory import memory_budget, refuse_over_budget
-from .. import _batches as batches
 
 __all__ = ["voxelize", "estimate_memory", "bytes_per_voxel", "grid_of", "ImplicitSource",
            "voxel_normals"]
@@ -44,7 +43,6 @@ _BYTES_PER_BOX = 512
 #: USELESS_MIN_CELLS voxels is flagged with a warning
 USELESS_SHARE = 0.5
 USELESS_MIN_CELLS = 4096
-#: voxels whose normals are computed per pass
 _NORMALS_CHUNK = batches.NORMALS
 
 
