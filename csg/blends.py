@@ -22,7 +22,7 @@ from typing import Any, Sequence
 import numpy as np
 
 import implicitvox as iv
-from implicitvox import Expr, _validate, x, y, z
+from implicitvox import Expr, validate, x, y, z
 
 from .solid import Bounds, Solid
 
@@ -41,7 +41,7 @@ class SmoothBoolean(Solid):
     def __init__(self, kind: str, a: Solid, b: Solid, radius: float):
         if kind not in ("union", "intersection", "difference"):
             raise ValueError(f"kind must be union, intersection or difference, got {kind!r}")
-        self.kind, self._children, self.radius = kind, (a, b), _validate.positive_number(radius, "radius")
+        self.kind, self._children, self.radius = kind, (a, b), validate.positive_number(radius, "radius")
 
     @property
     def children(self):

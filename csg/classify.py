@@ -37,7 +37,7 @@ from typing import Any, Callable, Optional
 import numpy as np
 
 import implicitvox as iv
-from implicitvox import _batches as batches
+from implicitvox import batches
 from implicitvox.expr.shape import AMBIGUOUS, EMPTY, FULL
 from implicitvox.mesh.crossings import RayWinding
 from implicitvox.mesh.pairs import sorted_unique

@@ -30,7 +30,7 @@ from typing import Any, Optional, Sequence
 import numpy as np
 
 import implicitvox as iv
-from implicitvox import Expr, _validate, x, y, z
+from implicitvox import Expr, validate, x, y, z
 
 from .facets import polygonal_radius
 from .solid import Bounds, Solid, Union
@@ -48,7 +48,7 @@ class Circle(Shape2D):
     """Disc of radius ``r`` about the origin."""
 
     def __init__(self, r: float = 1.0):
-        self.r = _validate.positive_number(r, "r")
+        self.r = validate.positive_number(r, "r")
 
     @property
     def expr(self) -> Expr:
@@ -193,7 +193,7 @@ class LinearExtrude(Solid):
     def __init__(self, shape: Solid, height: float, twist: float = 0.0, scale: Any = 1.0,
                  center: bool = False):
         self._children = (_as_2d(shape),)
-        self.height = _validate.positive_number(height, "height")
+        self.height = validate.positive_number(height, "height")
         self.twist = float(twist)
         s = np.broadcast_to(np.asarray(scale, dtype=np.float64), (2,)).copy()
         if not np.all(s >= 0) or not np.all(np.isfinite(s)):

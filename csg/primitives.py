@@ -21,7 +21,7 @@ from typing import Any, Optional, Sequence
 import numpy as np
 
 import implicitvox as iv
-from implicitvox import Expr, _validate, linf, x, y, z
+from implicitvox import Expr, validate, linf, x, y, z
 from implicitvox.mesh.inputs import as_triangles
 from implicitvox.octree.morton import CORNERS
 
@@ -32,11 +32,11 @@ __all__ = ["Sphere", "Box", "Cylinder", "Torus", "Ellipsoid", "HalfSpace", "Conv
            "Polyhedron"]
 
 
-_positive = _validate.positive_number
+_positive = validate.positive_number
 
 
 def _nonneg(value: Any, name: str) -> float:
-    return _validate.number_in(value, name, 0.0, float(np.finfo(np.float64).max))
+    return validate.number_in(value, name, 0.0, float(np.finfo(np.float64).max))
 
 
 def _point(value: Any, name: str) -> np.ndarray:

@@ -32,7 +32,7 @@ from typing import Any, Callable, Optional, Sequence
 import numpy as np
 
 import implicitvox as iv
-from implicitvox import Expr, _validate, x, y, z
+from implicitvox import Expr, validate, x, y, z
 
 from .classify import exact_classifier, plan, world_primitive
 
@@ -429,7 +429,7 @@ class ExprSolid(Solid):
     def __init__(self, expr: Any, bounds: Bounds = None):
         self._expr = iv.wrap(expr)
         if bounds is not None:
-            bounds = _validate.bounds(bounds)
+            bounds = validate.bounds(bounds)
         self._bounds = bounds
 
     @property

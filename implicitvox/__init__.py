@@ -12,7 +12,7 @@ Examples
 >>> float(f(0.0, 0.0, 2.0))
 1.0
 """
-from ._version import __version__
+from .version import __version__
 from .expr.nodes import Expr, constant, wrap, x, y, z
 from .expr.coords import (Cylindrical, Spherical, cylindrical, elevation, phi, r, radius, rho,
                           spherical, theta)

@@ -19,7 +19,7 @@ PACKAGES = ("implicitvox", "csg")
 
 #: the kernel's layers, bottom first: a module may import its own layer and those below
 LAYERS = [
-    ("implicitvox._validate", "implicitvox._lazy", "implicitvox._version", "implicitvox._batches"),
+    ("implicitvox.validate", "implicitvox.lazy", "implicitvox.version", "implicitvox.batches"),
     ("implicitvox.expr",),
     ("implicitvox.interval",),
     ("implicitvox.eval",),
@@ -86,9 +86,9 @@ def _imports(name: str, path: Path) -> list[tuple[str, list[str], int]]:
             else:
                 module = node.module or ""
             names = [a.name for a in node.names]
-            subs = [f"{module}.{n}" for n in names if f"{module}.{n}" in MODULES]
-            if subs:
-                found.extend((s, [], node.lineno) for s in subs)
+            subs = [n for n in names if f"{module}.{n}" in MODULES]
+            if subs:      # a submodule: the edge goes to it, and its own name counts too
+                found.extend((f"{module}.{n}", [n], node.lineno) for n in subs)
                 rest = [n for n in names if f"{module}.{n}" not in MODULES]
                 if rest:
                     found.append((module, rest, node.lineno))

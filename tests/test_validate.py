@@ -4,7 +4,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from implicitvox import _validate as v
+from implicitvox import validate as v
 
 
 @pytest.mark.parametrize("check, value, message", [

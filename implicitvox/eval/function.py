@@ -21,7 +21,7 @@ from typing import Any
 
 import numpy as np
 
-from .. import _validate
+from .. import validate
 from ..expr.nodes import Expr
 from .gradient import evaluate_gradients
 from .interval import evaluate_intervals
@@ -129,8 +129,8 @@ class Function:
         ValueError
             For wrong shapes, NaN, or ``lo > hi``.
         """
-        lo_arr = _validate.points(lo, "lo", finite=False)
-        hi_arr = _validate.points(hi, "hi", finite=False)
+        lo_arr = validate.points(lo, "lo", finite=False)
+        hi_arr = validate.points(hi, "hi", finite=False)
         if lo_arr.shape != hi_arr.shape:
             raise ValueError(f"lo and hi must have the same shape (n, 3); got {lo_arr.shape} "
                              f"and {hi_arr.shape}")

@@ -11,7 +11,7 @@ import numpy as np
 from ..interval import kernels as I
 from ..interval.float32 import exact_in_float32, float32_bounds, outward_float32
 from .tape import Tape
-from .. import _batches as batches
+from .. import batches
 
 __all__ = ["evaluate_intervals", "apply_op", "CHUNK"]
 

@@ -41,7 +41,7 @@ from typing import Any, Callable
 
 import numpy as np
 
-from .._lazy import mpmath
+from ..lazy import mpmath
 from ..interval import derivatives as D
 from ..interval import kernels as I
 from ..interval.float32 import exact_in_float32, in_float32_range

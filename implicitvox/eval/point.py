@@ -4,7 +4,7 @@ from __future__ import annotations
 import numpy as np
 
 from .tape import Tape
-from .. import _batches as batches
+from .. import batches
 
 __all__ = ["evaluate_points", "apply_point"]
 

@@ -32,7 +32,7 @@ from typing import Any
 
 import numpy as np
 
-from .. import _validate
+from .. import validate
 from .nodes import Expr, wrap, x, y, z
 
 __all__ = ["repeat", "repeat_polar", "FRAMES"]
@@ -53,14 +53,14 @@ def _spacing_and_count(spacing: Any, count: Any) -> tuple[tuple, tuple]:
         if s is None:
             out.append(None)
             continue
-        out.append(_validate.positive_number(s, f"spacing on {a} (or None)"))
+        out.append(validate.positive_number(s, f"spacing on {a} (or None)"))
     if count is None or isinstance(count, (int, np.integer)):
         counts = (count,) * 3
     else:
         counts = tuple(count)
         if len(counts) != 3:
             raise ValueError(f"count must be None, one int or three, got {count!r}")
-    counts = tuple(None if n is None else _validate.positive_int(n, f"count on {a} (or None)")
+    counts = tuple(None if n is None else validate.positive_int(n, f"count on {a} (or None)")
                    for a, n in zip("xyz", counts))
     if all(s is None for s in out):
         raise ValueError("spacing repeats along no axis")
@@ -87,6 +87,6 @@ def repeat_polar(expr: Any, n: int, axis: str = "z") -> Expr:
     """``n`` copies of ``expr`` turned about ``axis`` by ``2 pi / n`` each
     (gear teeth, bolt circles); copy 0 is ``expr`` itself, centred on the
     first of the other two axes."""
-    n = _validate.positive_int(n, "n")
-    axis = _validate.choice(axis, "axis", tuple(FRAMES))
+    n = validate.positive_int(n, "n")
+    axis = validate.choice(axis, "axis", tuple(FRAMES))
     return Expr("repeat_polar", (x, y, z), (wrap(expr), n, axis))

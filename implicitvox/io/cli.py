@@ -24,7 +24,7 @@ import time
 import traceback
 from typing import Any, Optional, Sequence
 
-from .. import _validate
+from .. import validate
 from ..expr.examples import EXAMPLES, example
 from ..mesh.inputs import MESH_SUFFIXES
 from ..octree.subdivide import RECHECK
@@ -161,13 +161,13 @@ def _voxelize(args: argparse.Namespace) -> int:
                                       args.model.endswith(".py") else {}))
     for path, flag in ((args.out, "--out"), (args.render, "--render")):
         if path is not None:
-            _validate.writable_path(path, flag)
+            validate.writable_path(path, flag)
     bounds = None
     if args.bounds:
         bounds = (tuple(args.bounds[:3]), tuple(args.bounds[3:]))
     bar = None if args.quiet else ProgressBar()
     max_memory = None if args.max_memory is None else \
-        _validate.max_memory(_validate.positive_number(args.max_memory, "--max-memory") * 2**30,
+        validate.max_memory(validate.positive_number(args.max_memory, "--max-memory") * 2**30,
                              "--max-memory (bytes)")
     if is_mesh:
         if args.normals or args.mean_value or args.subvoxel:

@@ -21,7 +21,7 @@ from typing import Any
 
 import numpy as np
 
-from .. import _validate
+from .. import validate
 from ..mesh.isolated import run_isolated
 from ..octree.grid import MAX_RESOLUTION, Grid
 from ..octree.store import Octree
@@ -48,7 +48,7 @@ def _suffix(path: str) -> str:
 def save(vox: Voxels, path: str) -> str:
     """Write ``vox`` to ``path``; the suffix picks the format. Returns the path."""
     ext = _suffix(path)
-    _validate.writable_path(path)
+    validate.writable_path(path)
     {".npz": _save_npz, ".vti": _save_vti, ".binvox": _save_binvox}[ext](vox, str(path))
     return str(path)
 

@@ -13,7 +13,7 @@ from typing import Any, Optional, Sequence
 
 import numpy as np
 
-from .. import _validate
+from .. import validate
 from ..octree.morton import CORNERS
 
 __all__ = ["to_pyvista", "render", "RenderError"]
@@ -87,7 +87,7 @@ def render(vox: Any, path: str, *, window_size: Sequence[int] = (1024, 768),
     if missing:
         raise RenderError("off-screen rendering needs the Debian packages "
                           f"{' '.join(missing)} (apt-get install them)")
-    path = _validate.writable_path(path)
+    path = validate.writable_path(path)
     pv = _pyvista()
     try:
         plotter = pv.Plotter(off_screen=True, window_size=list(window_size))

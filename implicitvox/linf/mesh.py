@@ -36,7 +36,7 @@ from ..octree import morton
 from .classify import Primitive
 from .norm import as_points, as_weights, in_blocks
 from .polyhedron import triangle_distance
-from .. import _batches as batches
+from .. import batches
 
 __all__ = ["TriangleMesh"]
 

@@ -31,7 +31,7 @@ import numpy as np
 from .. import expr as ex
 from .classify import Primitive
 from .norm import as_points, as_weights, in_blocks
-from .. import _batches as batches
+from .. import batches
 
 __all__ = ["ConvexPolyhedron", "HalfSpace", "triangle_distance", "CHUNK"]
 

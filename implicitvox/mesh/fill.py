@@ -23,7 +23,7 @@ from __future__ import annotations
 import warnings
 
 import numpy as np
-from .._lazy import LazyModule
+from ..lazy import LazyModule
 from ..octree import morton
 from ..octree.grid import Grid
 from .winding import winding_numbers

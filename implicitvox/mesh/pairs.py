@@ -37,7 +37,7 @@ from ..octree import morton
 from ..octree.grid import Grid
 from .ranges import expand_boxes
 from .tribox import Triangles, vertex_in_box
-from .. import _batches as batches
+from .. import batches
 
 __all__ = ["surface_codes", "sorted_unique", "CHUNK"]
 

@@ -33,7 +33,7 @@ from typing import Any, Optional
 
 import numpy as np
 
-from .. import _validate
+from .. import validate
 from .morton import MAX_BITS
 
 __all__ = ["Grid", "padded_bounds", "MAX_RESOLUTION"]
@@ -71,9 +71,9 @@ def padded_bounds(bounds: Any, resolution: Any = None, voxel_size: Any = None
                          f"x0 <= x1, ..., got {bounds!r:.80}")
     extent = hi - lo
     if voxel_size is not None:
-        pitch = np.broadcast_to(np.asarray(_validate.voxel_size(voxel_size), float), (3,))
+        pitch = np.broadcast_to(np.asarray(validate.voxel_size(voxel_size), float), (3,))
     else:
-        res = _validate.resolution(resolution, MAX_RESOLUTION)
+        res = validate.resolution(resolution, MAX_RESOLUTION)
         counts = np.broadcast_to(np.asarray(res, dtype=np.float64), (3,))
         if isinstance(res, tuple):
             pitch = np.where(counts > 1, extent / np.maximum(counts - 1, 1), extent)
@@ -100,17 +100,17 @@ class Grid:
     def from_bounds(cls, bounds: Any, resolution: Any = None, voxel_size: Any = None) -> "Grid":
         """The grid over ``bounds``: ``resolution`` voxels along the longest side
         (cubes) or per axis, or cubes of ``voxel_size`` (one of the two)."""
-        lo, hi = _validate.bounds(bounds)
+        lo, hi = validate.bounds(bounds)
         extent = np.subtract(hi, lo)
         if (resolution is None) == (voxel_size is None):
             raise ValueError("give one of resolution (voxels along the longest side) or "
                              "voxel_size")
         if voxel_size is not None:
-            size = _validate.voxel_size(voxel_size)
+            size = validate.voxel_size(voxel_size)
             sizes = size if isinstance(size, tuple) else (size,) * 3
             shape = tuple(_whole_voxels(e, h, a) for e, h, a in zip(extent, sizes, "xyz"))
             return cls(lo, tuple(float(h) for h in sizes), shape)
-        res = _validate.resolution(resolution, MAX_RESOLUTION)
+        res = validate.resolution(resolution, MAX_RESOLUTION)
         if isinstance(res, tuple):
             return cls(lo, tuple(float(e / n) for e, n in zip(extent, res)), res)
         longest = int(np.argmax(extent))

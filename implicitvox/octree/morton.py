@@ -18,7 +18,7 @@ Examples
 from __future__ import annotations
 
 import numpy as np
-from .. import _batches as batches
+from .. import batches
 
 __all__ = ["encode", "decode", "MAX_BITS", "CORNERS"]
 

@@ -39,7 +39,7 @@ from .precision import interval_dtype, level_dtype
 from ..interval.float32 import outward_float32
 from ..eval.precision import supports_float32
 from ..expr.shape import AMBIGUOUS, EMPTY, FULL
-from .. import _batches as batches
+from .. import batches
 
 __all__ = ["subdivide", "Subdivision", "classify", "suspect_voxels", "recheck_voxels", "CHUNK",
            "RECHECK"]

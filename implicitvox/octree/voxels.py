@@ -18,7 +18,7 @@ from typing import Any, Callable, Optional, Protocol, runtime_checkable
 
 import numpy as np
 
-from .. import _validate
+from .. import validate
 from .grid import Grid
 from .store import Octree
 
@@ -193,7 +193,7 @@ class Voxels:
         MemoryError
             When the estimate, or the run itself, exceeds ``max_memory``.
         """
-        levels = _validate.positive_int(levels, "levels")
+        levels = validate.positive_int(levels, "levels")
         if self.grid.depth + levels > 21:
             raise ValueError(f"refine({levels}) of a depth-{self.grid.depth} grid exceeds the "
                              "octree's 21 levels")

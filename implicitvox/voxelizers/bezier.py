@@ -18,7 +18,7 @@ from typing import Any, Callable, Iterable, Optional, Union
 
 import numpy as np
 
-from .. import _validate
+from .. import validate
 from ..mesh.bezier import BezierPatch, bezier_triangles
 from ..mesh.pairs import surface_codes
 from ..mesh.tribox import Triangles
@@ -97,7 +97,7 @@ def voxelize_bezier(patches: Union[BezierPatch, Iterable[BezierPatch]],
     for i, p in enumerate(patches):
         if not isinstance(p, BezierPatch):
             raise TypeError(f"patches[{i}] must be a BezierPatch, got {type(p).__name__}")
-    flatness = _validate.number_in(flatness, "flatness", 0, 4, open_low=True)
+    flatness = validate.number_in(flatness, "flatness", 0, 4, open_low=True)
     own = None
     if bounds is None:
         if not patches:

@@ -17,9 +17,9 @@ from typing import Any, Callable, Optional, Union
 
 import numpy as np
 
-from .. import _batches as batches
-from .. import _validate
-from .._version import __version__
+from .. import batches
+from .. import validate
+from ..version import __version__
 from ..eval.function import Function
 from ..expr.shape import as_shape, exact_classifier, voxel_classifier
 from ..octree import morton
@@ -203,11 +203,11 @@ def voxelize(shape: Any, resolution: Union[int, tuple[int, int, int], None] = No
     """
     shape = as_shape(shape)
     budget = memory_budget(max_memory)
-    options = {"interior": _validate.boolean(interior, "interior"),
-               "normals": _validate.boolean(normals, "normals"),
-               "mean_value": _validate.boolean(mean_value, "mean_value"),
-               "subvoxel": _validate.int_in(subvoxel, "subvoxel", 0, 4),
-               "recheck": _validate.number_in(recheck, "recheck", 0.0, 4.0)}
+    options = {"interior": validate.boolean(interior, "interior"),
+               "normals": validate.boolean(normals, "normals"),
+               "mean_value": validate.boolean(mean_value, "mean_value"),
+               "subvoxel": validate.int_in(subvoxel, "subvoxel", 0, 4),
+               "recheck": validate.number_in(recheck, "recheck", 0.0, 4.0)}
     grid = grid_of(getattr(shape, "bounds", None), bounds, resolution, voxel_size)
     if grid.depth + options["subvoxel"] > 21:
         raise ValueError(f"resolution {grid.shape} with subvoxel={subvoxel} exceeds the octree's "

@@ -16,7 +16,7 @@ from __future__ import annotations
 
 from typing import Any, Optional
 
-from .. import _validate
+from .. import validate
 
 __all__ = ["memory_budget", "available_memory", "refuse_over_budget"]
 
@@ -81,7 +81,7 @@ def _rlimit_room() -> Optional[int]:
 
 def memory_budget(max_memory: Any) -> int:
     """The byte budget of a run: ``max_memory`` (checked), or half the available memory."""
-    checked = _validate.max_memory(max_memory)
+    checked = validate.max_memory(max_memory)
     return available_memory() // 2 if checked is None else checked
 
 

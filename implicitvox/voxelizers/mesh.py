@@ -25,7 +25,7 @@ from typing import Any, Callable, Optional, Union
 
 import numpy as np
 
-from .. import _validate
+from .. import validate
 from ..mesh.fill import BYTES_PER_VOXEL, interior_octants
 from ..mesh.inputs import as_triangles
 from ..mesh.pairs import surface_codes
@@ -136,7 +136,7 @@ def voxelize_mesh(mesh: Any, resolution: Union[int, tuple[int, int, int], None] 
         When the estimate exceeds ``max_memory``.
     """
     vertices, faces = as_triangles(mesh)
-    interior = _validate.boolean(interior, "interior")
+    interior = validate.boolean(interior, "interior")
     budget = memory_budget(max_memory)
     if not len(faces) and bounds is None:
         raise ValueError("the mesh has no triangles: pass bounds to get an empty voxelization")

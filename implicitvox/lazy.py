@@ -5,7 +5,7 @@ hull constructions; neither is imported until a function touches it.
 
 Examples
 --------
->>> from implicitvox._lazy import mpmath
+>>> from implicitvox.lazy import mpmath
 >>> float(mpmath.sqrt(4))
 2.0
 """

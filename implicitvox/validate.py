@@ -8,7 +8,7 @@ same everywhere.
 
 Examples
 --------
->>> from implicitvox import _validate as v
+>>> from implicitvox import validate as v
 >>> v.positive_int(3, "levels")
 3
 >>> v.positive_int(True, "levels")
