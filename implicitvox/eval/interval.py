@@ -10,6 +10,7 @@ import numpy as np
 
 from ..interval import kernels as I
 from ..interval.float32 import exact_in_float32, float32_bounds, outward_float32
+from .pruning import settle
 from .tape import Tape
 from .. import batches
 
@@ -21,7 +22,8 @@ CHUNK = batches.BOXES
 
 def evaluate_intervals(tape: Tape, lo: tuple[np.ndarray, np.ndarray, np.ndarray],
                        hi: tuple[np.ndarray, np.ndarray, np.ndarray], dtype=np.float64,
-                       native: bool = False) -> tuple[np.ndarray, np.ndarray]:
+                       native: bool = False, choices: np.ndarray | None = None
+                       ) -> tuple[np.ndarray, np.ndarray]:
     """Enclosures ``(flo, fhi)`` of the taped function over boxes.
 
     Parameters
@@ -44,6 +46,11 @@ def evaluate_intervals(tape: Tape, lo: tuple[np.ndarray, np.ndarray, np.ndarray]
     native : bool, default: False
         Return the enclosures in ``dtype`` (float32 ends are exact in
         float64, so only the conversion is saved).
+    choices : ndarray of int8, optional
+        Shape ``(len(tape.branches),) + broadcast shape``: filled with the
+        choice of each branch instruction over each box
+        (:func:`implicitvox.eval.pruning.settle`), for the pruned tapes of
+        the boxes' subtrees.
 
     Returns
     -------
@@ -61,12 +68,12 @@ def evaluate_intervals(tape: Tape, lo: tuple[np.ndarray, np.ndarray, np.ndarray]
     result = np.float32 if single and native else np.float64
     flo, fhi = np.empty(shape, dtype=result), np.empty(shape, dtype=result)
     if columns <= step:
-        _evaluate(tape, lo, hi, single, flo, fhi)
+        _evaluate(tape, lo, hi, single, flo, fhi, choices)
         return flo, fhi
     for s in range(0, columns, step):   # in passes of `step` columns
         part = np.s_[..., s:s + step]
         _evaluate(tape, tuple(c[part] for c in lo), tuple(c[part] for c in hi), single,
-                  flo[part], fhi[part])
+                  flo[part], fhi[part], None if choices is None else choices[part])
     return flo, fhi
 
 
@@ -90,12 +97,18 @@ def apply_op(op, param, lo: tuple, hi: tuple, single: bool = False):
     return op.interval(lo, hi, param)
 
 
-def _evaluate(tape, lo, hi, single: bool, flo: np.ndarray, fhi: np.ndarray) -> None:
-    """The enclosures over one pass of boxes, written into ``flo, fhi``."""
+def _evaluate(tape, lo, hi, single: bool, flo: np.ndarray, fhi: np.ndarray,
+              choices: np.ndarray | None = None) -> None:
+    """The enclosures over one pass of boxes, written into ``flo, fhi`` (and the
+    branch choices into ``choices``)."""
     shape = flo.shape
+    if choices is not None:
+        choices[...] = 0
     if tape.undefined:
         flo[...], fhi[...] = np.inf, -np.inf
         return
+    branch = 0
+    dtype = np.float32 if single else np.float64
     rlo: list = [None] * tape.n_registers
     rhi: list = [None] * tape.n_registers
     for axis, name in enumerate("xyz"):
@@ -110,8 +123,11 @@ def _evaluate(tape, lo, hi, single: bool, flo: np.ndarray, fhi: np.ndarray) -> N
     empty = None
     with np.errstate(all="ignore"):
         for ins in tape.instructions:
-            result = apply_op(ins.op, ins.param, tuple(rlo[a] for a in ins.args),
-                              tuple(rhi[a] for a in ins.args), single)
+            args_lo, args_hi = tuple(rlo[a] for a in ins.args), tuple(rhi[a] for a in ins.args)
+            if ins.op.choice and choices is not None:
+                np.copyto(choices[branch], settle(ins.op.name, args_lo, args_hi, dtype))
+                branch += 1
+            result = apply_op(ins.op, ins.param, args_lo, args_hi, single)
             if ins.op.domain:
                 result, lane_empty = result[:2], result[2]
                 empty = lane_empty if empty is None else (empty | lane_empty)

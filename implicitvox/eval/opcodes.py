@@ -33,6 +33,8 @@ Examples
 ['acos', 'asin', 'log', 'powr', 'repeat', 'repeat_polar', 'sqrt']
 >>> sorted(name for name, op in OPCODES.items() if op.oracle)
 ['repeat', 'repeat_polar']
+>>> sorted(name for name, op in OPCODES.items() if op.choice)
+['abs', 'max', 'min']
 """
 from __future__ import annotations
 
@@ -82,6 +84,9 @@ class Opcode:
     #: the mpmath reference is not evaluated beyond this argument magnitude (it would
     #: need pi or ln 2 to thousands of digits); the value is then "not checked"
     reference_limit: float | None = None
+    #: a branch over a box: which operand decides (min, max) or which sign (abs) can
+    #: be settled by the operands' enclosures (:mod:`implicitvox.eval.pruning`)
+    choice: bool = False
 
 
 def _un(f):
@@ -284,7 +289,7 @@ _ROWS = [
          rule=D.d_sqrt, float32=True),
     _row("abs", 1, _un(np.abs), _iun(I.i_abs),
          lambda v, g, o, p: np.sign(v[0]) * g[0], lambda a, p: abs(a[0]), exact=True,
-         rule=D.d_abs, float32=True),
+         rule=D.d_abs, float32=True, choice=True),
     _row("exp", 1, _un(np.exp), _iun(I.i_exp),
          lambda v, g, o, p: o * g[0], lambda a, p: mpmath.exp(a[0]),
          rule=D.d_exp, reference_limit=EXP_LIMIT, float32=True),
@@ -319,10 +324,10 @@ _ROWS = [
          rule=D.d_hypot, float32=True),
     _row("min", 2, _bin(np.minimum), _ibin(I.i_min),
          _d_minmax(lambda a, b: a <= b), lambda a, p: min(a[0], a[1]), exact=True,
-         rule=D.d_min, float32=True),
+         rule=D.d_min, float32=True, choice=True),
     _row("max", 2, _bin(np.maximum), _ibin(I.i_max),
          _d_minmax(lambda a, b: a >= b), lambda a, p: max(a[0], a[1]), exact=True,
-         rule=D.d_max, float32=True),
+         rule=D.d_max, float32=True, choice=True),
     # Tape-made forms of + - * / with an exact constant operand (the parameter):
     # two products instead of four, no sign cases (Stolte §2's constant rule).
     _row("addc", 1, lambda a, p: a[0] + p, lambda lo, hi, p: I.i_addc(lo[0], hi[0], p),

@@ -43,7 +43,7 @@ from ..expr.nodes import Expr, VARIABLES
 from .opcodes import OPCODES, Opcode
 from .oracles import compile_oracle
 
-__all__ = ["Tape", "Instruction", "Constant", "build_tape", "compiled_oracle"]
+__all__ = ["Tape", "Instruction", "Constant", "Value", "build_tape", "allocate", "compiled_oracle"]
 
 
 @dataclass(frozen=True)
@@ -86,9 +86,39 @@ class Tape:
     def has_domain_ops(self) -> bool:
         return any(ins.op.domain for ins in self.instructions)
 
+    @functools.cached_property
+    def graph(self) -> tuple[tuple["Value", ...], int, tuple[bool, ...]]:
+        """The tape as the graph :func:`allocate` takes: values (the constants,
+        the inputs, then one per instruction, in order; arguments as indices),
+        the root's index, and whether each value reads a domain operation."""
+        values: list[Value] = []
+        node_of: dict[int, int] = {}          # register -> value, as the tape runs
+        for c in self.constants:
+            node_of[c.register] = len(values)
+            values.append(Value("const", const=(c.value, c.lo, c.hi)))
+        for name, register in self.inputs.items():
+            if register >= 0:
+                node_of[register] = len(values)
+                values.append(Value("var", param=name))
+        domain = [False] * len(values)
+        for ins in self.instructions:
+            args = tuple(node_of[a] for a in ins.args)
+            domain.append(ins.op.domain or any(domain[a] for a in args))
+            node_of[ins.out] = len(values)
+            values.append(Value("op", op=ins.op, args=args, param=ins.param))
+        return tuple(values), node_of[self.output], tuple(domain)
+
+    @functools.cached_property
+    def branches(self) -> tuple[int, ...]:
+        """Positions of the instructions with a choice (``min``, ``max``, ``abs``):
+        the ones :mod:`implicitvox.eval.pruning` can settle over a box."""
+        return tuple(i for i, ins in enumerate(self.instructions) if ins.op.choice)
+
 
 @dataclass
-class _Value:
+class Value:
+    """A node of the deduplicated graph a tape is allocated from (:func:`allocate`)."""
+
     kind: str                     # "var" | "const" | "op"
     op: Opcode | None = None
     args: tuple[int, ...] = ()
@@ -96,7 +126,7 @@ class _Value:
     const: tuple[float, float, float] | None = None  # value, lo, hi (lo > hi: undefined)
 
 
-def _fold(op: Opcode, args: list[_Value], param: Any) -> tuple[float, float, float]:
+def _fold(op: Opcode, args: list[Value], param: Any) -> tuple[float, float, float]:
     """Point value and enclosure of ``op`` over constant arguments."""
     consts = [a.const for a in args]
     if any(c[1] > c[2] for c in consts):
@@ -116,11 +146,11 @@ def _fold(op: Opcode, args: list[_Value], param: Any) -> tuple[float, float, flo
 
 def build_tape(expr: Expr) -> Tape:
     """Flatten ``expr`` into a :class:`Tape` (iterative; any depth)."""
-    values: list[_Value] = []
+    values: list[Value] = []
     index_of_key: dict[Any, int] = {}
     index_of_node: dict[int, int] = {}
 
-    def intern(key: Any, value: _Value) -> int:
+    def intern(key: Any, value: Value) -> int:
         found = index_of_key.get(key)
         if found is not None:
             return found
@@ -130,10 +160,10 @@ def build_tape(expr: Expr) -> Tape:
 
     for node in expr.walk():
         if node.op == "var":
-            idx = intern(("var", node.param), _Value("var", param=node.param))
+            idx = intern(("var", node.param), Value("var", param=node.param))
         elif node.op == "const":
             v = node.param
-            idx = intern(("const", v.hex(), v.hex(), v.hex()), _Value("const", const=(v, v, v)))
+            idx = intern(("const", v.hex(), v.hex(), v.hex()), Value("const", const=(v, v, v)))
         else:
             if node.op not in OPCODES:
                 raise ValueError(f"unknown opcode {node.op!r} in expression")
@@ -150,22 +180,22 @@ def build_tape(expr: Expr) -> Tape:
                 # evaluators, which read tapes)
                 c = _fold(op, [values[a] for a in args], param)
                 key = ("const",) + tuple(float(t).hex() for t in c)
-                idx = intern(key, _Value("const", const=c))
+                idx = intern(key, Value("const", const=c))
             else:
                 idx = intern((op.name, _param_key(param), args),
-                             _Value("op", op=op, args=args, param=param))
+                             Value("op", op=op, args=args, param=param))
         index_of_node[id(node)] = idx
-    return _allocate(values, index_of_node[id(expr)])
+    return allocate(values, index_of_node[id(expr)])
 
 
-def _exact_constant(value: _Value) -> float | None:
+def _exact_constant(value: Value) -> float | None:
     if value.kind == "const" and value.const[1] == value.const[2] == value.const[0]:
         return value.const[0]
     return None
 
 
 def _with_constant_operand(op: Opcode, args: tuple[int, ...], param: Any,
-                           values: list[_Value]) -> tuple[Opcode, tuple[int, ...], Any]:
+                           values: list[Value]) -> tuple[Opcode, tuple[int, ...], Any]:
     """``a + c``, ``a - c``, ``c - a``, ``a * c``, ``a / c`` with an exact constant
     ``c`` become the one-argument rows ``addc, rsubc, mulc, divc``."""
     if op.name not in ("add", "sub", "mul", "div"):
@@ -185,7 +215,7 @@ def _with_constant_operand(op: Opcode, args: tuple[int, ...], param: Any,
 
 
 def _periodic_of_angle(op: Opcode, args: tuple[int, ...], param: Any,
-                       values: list[_Value]) -> tuple[Opcode, tuple[int, ...], Any]:
+                       values: list[Value]) -> tuple[Opcode, tuple[int, ...], Any]:
     """``sin``/``cos`` of ``k * atan2(v, u) + c`` (``k`` an integer) become one
     ``periodic_angle`` node, tight across the branch cut
     (:func:`implicitvox.interval.kernels.angle_interval`)."""
@@ -201,7 +231,7 @@ def _periodic_of_angle(op: Opcode, args: tuple[int, ...], param: Any,
     return OPCODES["periodic_angle"], node.args, (op.name, float(k), float(c))
 
 
-def _distance_of_squares(op: Opcode, args: tuple[int, ...], param: Any, values: list[_Value],
+def _distance_of_squares(op: Opcode, args: tuple[int, ...], param: Any, values: list[Value],
                          intern) -> tuple[Opcode, tuple[int, ...], Any]:
     """``sqrt(t0 + t1)`` or ``sqrt((t0 + t1) + t2)``, each ``t`` a ``square(a)`` or
     ``square(a + k)``, becomes ``distance(a0, a1, a2; centre)`` (a missing third
@@ -222,13 +252,13 @@ def _distance_of_squares(op: Opcode, args: tuple[int, ...], param: Any, values: 
         return op, args, param
     if len(found) == 2:
         zero = intern(("const", 0.0.hex(), 0.0.hex(), 0.0.hex()),
-                      _Value("const", const=(0.0, 0.0, 0.0)))
+                      Value("const", const=(0.0, 0.0, 0.0)))
         found.append((zero, 0.0))
     return (OPCODES["distance"], tuple(r for r, _ in found),
             tuple(float(c) for _, c in found))
 
 
-def _square_term(index: int, values: list[_Value]) -> tuple[int, float] | None:
+def _square_term(index: int, values: list[Value]) -> tuple[int, float] | None:
     """``(a, c)`` when ``values[index]`` is ``square(a - c)`` (``c`` may be 0)."""
     term = values[index]
     if term.kind != "op" or term.op.name != "square":
@@ -248,8 +278,10 @@ def _param_key(param: Any) -> Any:
     return param.hex() if isinstance(param, float) else param
 
 
-def _allocate(values: list[_Value], root: int) -> Tape:
-    """Assign registers, reusing those whose last reader has run."""
+def allocate(values: list[Value], root: int) -> Tape:
+    """The tape of ``values[root]``: registers assigned in the order of ``values``
+    (topological: arguments first), reused once their last reader has run;
+    values the root does not depend on are left out."""
     live = _reachable(values, root)
     last_use: dict[int, int] = {}
     for i in live:
@@ -299,7 +331,7 @@ def _allocate(values: list[_Value], root: int) -> Tape:
                 register[root], undefined)
 
 
-def _reachable(values: list[_Value], root: int) -> list[int]:
+def _reachable(values: list[Value], root: int) -> list[int]:
     """Indices of values the root depends on, in increasing (topological) order."""
     needed = {root}
     for i in range(root, -1, -1):

@@ -7,13 +7,15 @@ Examples
 --------
 >>> from implicitvox.expr.examples import EXAMPLES, example
 >>> sorted(EXAMPLES)[:3]
-['blobby', 'flange', 'gear']
+['blobby', 'drilled-plate', 'flange']
 >>> example("gear").bounds
 ((-1.0, -0.3, -1.0), (1.0, 0.3, 1.0))
 """
 from __future__ import annotations
 
 from typing import Callable
+
+import builtins
 
 import numpy as np
 
@@ -24,7 +26,7 @@ from .shape import ExprShape
 from .sweeps import repeat, repeat_polar
 
 __all__ = ["EXAMPLES", "example", "sinsin", "gear", "replicated_torus", "flange", "blobby",
-           "lobed_plate"]
+           "lobed_plate", "menger", "sphere_union", "drilled_plate"]
 
 
 def sinsin(n: int, m: int) -> ExprShape:
@@ -80,6 +82,46 @@ def lobed_plate() -> ExprShape:
                      ((-1.3, -0.2, -1.3), (1.3, 0.2, 1.3)))
 
 
+def menger(level: int = 3) -> ExprShape:
+    """The Menger sponge of ``level``: the cube ``[-1, 1]^3`` minus, at each level
+    ``k``, the ``3 * 9**(k - 1)`` square bars of side ``2 / 3**k`` through it
+    along x, y and z (273 bars at level 3): a CSG model of many parts, with
+    sharp edges everywhere."""
+    bars = []
+    for k in range(1, level + 1):
+        half = 1.0 / 3 ** k
+        centres = [-1.0 + (2 * i + 1) / 3 ** (k - 1) for i in range(3 ** (k - 1))]
+        for u in centres:
+            for v in centres:
+                bars.append(max(abs(y - u) - half, abs(z - v) - half))   # along x
+                bars.append(max(abs(z - u) - half, abs(x - v) - half))   # along y
+                bars.append(max(abs(x - u) - half, abs(y - v) - half))   # along z
+    cube = max(abs(x), abs(y), abs(z)) - 1.0
+    return ExprShape(max(cube, -min(*bars)) if bars else cube, ((-1.0,) * 3, (1.0,) * 3))
+
+
+def sphere_union(n: int = 100, seed: int = 1) -> ExprShape:
+    """The union of ``n`` spheres at random centres in ``[-1, 1]^3``, of radius
+    ``0.6 / n**(1/3)`` (a CSG model whose parts each matter only nearby)."""
+    rng = np.random.default_rng(seed)
+    radius = 0.6 / n ** (1.0 / 3.0)
+    spheres = [sqrt((x - a) ** 2 + (y - b) ** 2 + (z - c) ** 2) - radius
+               for a, b, c in rng.uniform(-1.0, 1.0, (n, 3))]
+    reach = 1.0 + radius
+    return ExprShape(min(*spheres) if n > 1 else spheres[0], ((-reach,) * 3, (reach,) * 3))
+
+
+def drilled_plate(rows: int = 20, columns: int = 20) -> ExprShape:
+    """A 2 x 2 x 0.2 plate with a ``rows`` x ``columns`` grid of cylindrical holes
+    drilled through it along z (a typical OpenSCAD part)."""
+    plate = max(abs(x) - 1.0, abs(y) - 1.0, abs(z) - 0.1)
+    radius = 0.3 / builtins.max(rows, columns)
+    holes = [radius - sqrt((x - (-1.0 + (2 * i + 1) / columns)) ** 2
+                           + (y - (-1.0 + (2 * j + 1) / rows)) ** 2)
+             for i in range(columns) for j in range(rows)]
+    return ExprShape(max(plate, *holes), ((-1.0, -1.0, -0.1), (1.0, 1.0, 0.1)))
+
+
 def _sphere() -> ExprShape:
     return ExprShape(sqrt(x * x + y * y + z * z) - 1.0, ((-1.1,) * 3, (1.1,) * 3))
 
@@ -96,6 +138,9 @@ EXAMPLES: dict[str, tuple[str, Callable[[], ExprShape]]] = {
     "flange": ("a flange with a bolt circle (repeat_polar)", flange),
     "blobby": ("six blobby spheres (sum of Gaussians)", blobby),
     "sphere": ("the unit sphere", _sphere),
+    "menger": ("the level-2 Menger sponge: a cube minus 30 bars", lambda: menger(2)),
+    "spheres": ("the union of 30 random spheres", lambda: sphere_union(30)),
+    "drilled-plate": ("a plate with 8 x 8 holes drilled through it", lambda: drilled_plate(8, 8)),
 }
 
 

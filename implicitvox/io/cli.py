@@ -143,6 +143,9 @@ def _parser() -> argparse.ArgumentParser:
     vox.add_argument("--recheck", type=float, default=RECHECK, metavar="STRENGTH",
                      help="recheck on sub-voxels the voxels predicted to be false "
                           f"(default {RECHECK}; 0 = off, up to 4 = nearly all)")
+    vox.add_argument("--no-prune", dest="prune", action="store_false",
+                     help="evaluate the whole expression everywhere (the same voxels, slower "
+                          "on models of many parts; for comparison)")
     vox.add_argument("--out", help="write .npz, .vti or .binvox")
     vox.add_argument("--render", metavar="PNG", help="render a picture")
     vox.add_argument("--max-memory", type=float, metavar="GIB", help="refuse runs estimated above")
@@ -180,7 +183,7 @@ def _voxelize(args: argparse.Namespace) -> int:
         vox = voxelize(shape, args.resolution, bounds=bounds, voxel_size=args.voxel_size,
                        interior=args.interior, normals=args.normals or bool(args.render),
                        progress=bar, max_memory=max_memory, mean_value=args.mean_value,
-                       subvoxel=args.subvoxel, recheck=args.recheck)
+                       subvoxel=args.subvoxel, recheck=args.recheck, prune=args.prune)
     if bar:
         bar.close()
     meta = vox.metadata

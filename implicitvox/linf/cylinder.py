@@ -194,7 +194,7 @@ class Frustum(Primitive):
             C = np.sum(Pz0 * z0, axis=1) + 2 * (z0 @ lv) + c1
             # every time the line is tangent to the (double) quadric is a candidate: a
             # tangency on the real cone, at a point of the edge, is a genuine contact
-            with np.errstate(divide="ignore", invalid="ignore"):
+            with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
                 r1, r2 = quadratic_roots(np.where(A != 0, A, 1.0), B, C)
                 lin = np.where(B != 0, -C / (2 * B), np.nan)
             for t1 in (np.where(A != 0, r1, lin), np.where(A != 0, r2, np.nan)):

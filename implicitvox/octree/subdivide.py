@@ -31,6 +31,10 @@ from typing import Any, Callable, Optional
 import numpy as np
 
 from ..eval.function import Function
+from ..eval.interval import evaluate_intervals
+from ..eval.pruning import Pruner
+from ..eval.tape import Tape
+from .frontier import Frontier
 from .grid import Grid
 from .guard import MemoryGuard
 from . import morton
@@ -41,8 +45,8 @@ from ..eval.precision import supports_float32
 from ..expr.shape import AMBIGUOUS, EMPTY, FULL
 from .. import batches
 
-__all__ = ["subdivide", "Subdivision", "classify", "suspect_voxels", "recheck_voxels", "CHUNK",
-           "RECHECK"]
+__all__ = ["subdivide", "Subdivision", "classify", "classify_children", "suspect_voxels",
+           "recheck_voxels", "prunes_at", "CHUNK", "RECHECK", "PRUNE_EVERY", "PRUNE_MIN_BELOW"]
 
 #: octants classified per interval evaluation
 CHUNK = batches.FRONTIER
@@ -51,6 +55,10 @@ CHUNK = batches.FRONTIER
 #: are predicted to settle them
 RECHECK = 0.25
 _CHILD_OFFSETS = morton.CORNERS.astype(np.int32)
+#: tapes are pruned every PRUNE_EVERY levels, down to PRUNE_MIN_BELOW levels above the
+#: voxels (:func:`prunes_at`)
+PRUNE_EVERY = 2
+PRUNE_MIN_BELOW = 3
 
 
 @dataclass
@@ -59,10 +67,17 @@ class Subdivision:
 
     #: Morton codes (uint64) of the surface voxels, in no particular order
     codes: np.ndarray
-    #: FULL octants per level: level -> (m, 3) int32 coordinates at that level
+    #: FULL octants per level: level -> (m, 3) int32 coordinates at that level, in
+    #: Morton order
     interior: dict[int, np.ndarray] = field(default_factory=dict)
     #: octants classified (boxes evaluated)
     evaluated: int = 0
+    #: the tapes valid over the voxels, as runs ``(count, tape)`` in the order of
+    #: :attr:`codes` (pruned tapes, :mod:`implicitvox.eval.pruning`; with
+    #: ``leaf_level``, the tape of each code's ancestor at that level)
+    tapes: list = field(default_factory=list)
+    #: distinct pruned tapes built
+    tapes_built: int = 0
 
     @property
     def surface(self) -> np.ndarray:
@@ -96,10 +111,10 @@ def classify(func: Function, grid: Grid, level: int, coords: np.ndarray,
         dtype = interval_dtype(func.tape, grid, level)
     flo, fhi = func.interval_columns(lo, hi, dtype)
     state = _states(flo, fhi)
-    return _tighten(func, lo, hi, flo, fhi, state, exact, mean_value)
+    return _tighten(func.tape, lo, hi, flo, fhi, state, exact, mean_value)
 
 
-def _tighten(func: Function, lo, hi, flo: np.ndarray, fhi: np.ndarray, state: np.ndarray,
+def _tighten(tape: Tape, lo, hi, flo: np.ndarray, fhi: np.ndarray, state: np.ndarray,
              exact, mean_value: bool) -> np.ndarray:
     """Settle the AMBIGUOUS states further: the mean value form (reusing the
     natural bounds ``flo, fhi`` already computed), then the exact test."""
@@ -107,7 +122,7 @@ def _tighten(func: Function, lo, hi, flo: np.ndarray, fhi: np.ndarray, state: np
         amb = np.flatnonzero(state == AMBIGUOUS)
         if amb.size:
             sub_lo, sub_hi = tuple(c[amb] for c in lo), tuple(c[amb] for c in hi)
-            mlo, mhi = mean_value_enclosure(func.tape, sub_lo, sub_hi, (flo[amb], fhi[amb]))
+            mlo, mhi = mean_value_enclosure(tape, sub_lo, sub_hi, (flo[amb], fhi[amb]))
             state[amb] = _states(mlo, mhi)
     if exact is not None:
         amb = np.flatnonzero(state == AMBIGUOUS)
@@ -193,13 +208,17 @@ def _child_edges(grid: Grid, level: int, axis: int, single: bool
     return low, high
 
 
-def _child_states(func: Function, grid: Grid, level: int, parents: np.ndarray, dtype):
+def _child_states(tape: Tape, grid: Grid, level: int, parents: np.ndarray, dtype,
+                  record: bool = False):
     """States (8, m) of the children of octants ``parents`` (Morton codes) at
-    ``level``, child-major, EMPTY past the grid; and their bounds (8 m) and
-    the number of children inside the grid."""
+    ``level``, child-major, EMPTY past the grid; their bounds (8 m), the
+    number of children inside the grid, which are inside, and (``record``)
+    the branch choices ``(len(tape.branches), 8 m)`` over them."""
     axes = _axes(parents)
     lo, hi = _child_boxes(grid, level, axes, single=np.dtype(dtype) == np.float32)
-    flo, fhi = func.interval_columns(lo, hi, dtype, native=True)
+    choices = np.empty((len(tape.branches), 2, 2, 2, len(parents)), dtype=np.int8) \
+        if record else None
+    flo, fhi = evaluate_intervals(tape, lo, hi, dtype, native=True, choices=choices)
     flo, fhi = flo.reshape(-1), fhi.reshape(-1)     # child-major: index = child * m + parent
     state = _states(flo, fhi)
     classified = state.size
@@ -207,13 +226,27 @@ def _child_states(func: Function, grid: Grid, level: int, parents: np.ndarray, d
     if inside is not None:
         state *= inside
         classified = int(np.count_nonzero(inside))
-    return state, flo, fhi, classified, inside
+    if record:
+        choices = choices.reshape(len(tape.branches), -1)
+    return state, flo, fhi, classified, inside, choices
 
 
-def classify_children(func: Function, grid: Grid, level: int, parents: np.ndarray,
+def prunes_at(level: int, depth: int) -> bool:
+    """Whether the choices over the children of octants at ``level`` are recorded to
+    prune their subtrees' tapes: every :data:`PRUNE_EVERY` levels, and only where
+    :data:`PRUNE_MIN_BELOW` levels at least lie below the children. Recording
+    costs about a third of an evaluation, and the deepest levels hold most
+    boxes; pruning there would split the frontier into batches too small for
+    numpy (measured in tests/benchmarks/bench_pruning.py)."""
+    below = depth - level - 1
+    return below >= PRUNE_MIN_BELOW and below % PRUNE_EVERY == 0
+
+
+def classify_children(tape: Tape, grid: Grid, level: int, parents: np.ndarray,
                       exact=None, mean_value: bool = False, dtype=np.float64,
-                      full: bool = False, recheck: float = 0.0
-                      ) -> tuple[np.ndarray, Optional[np.ndarray], np.ndarray, int]:
+                      full: bool = False, recheck: float = 0.0,
+                      pruner: Optional[Pruner] = None
+                      ) -> tuple[list, Optional[np.ndarray], list, int]:
     """The AMBIGUOUS children of octants at ``level`` (and the FULL ones if ``full``).
 
     ``parents`` and the children returned are Morton codes. One broadcast
@@ -222,30 +255,43 @@ def classify_children(func: Function, grid: Grid, level: int, parents: np.ndarra
     AMBIGUOUS ones, as in :func:`classify`. At the voxel level, without an
     exact test, the AMBIGUOUS children that :func:`suspect_voxels` picks
     (``recheck`` > 0) are *suspects* (see :func:`recheck_voxels`), returned
-    apart. Returns ``(ambiguous, full, suspects, classified)``: ``full`` None
-    unless asked for, ``classified`` the number of boxes classified.
+    apart. With a ``pruner``, the children are grouped by the branch choices
+    their enclosures settled, each group with its pruned tape (valid over the
+    group's boxes; :mod:`implicitvox.eval.pruning`). Returns ``(ambiguous,
+    full, suspects, classified)``: ``ambiguous`` and ``suspects`` lists of
+    groups ``(codes, tape)``, ``full`` codes or None unless asked for,
+    ``classified`` the number of boxes classified.
     """
-    state, flo, fhi, classified, inside = _child_states(func, grid, level, parents, dtype)
+    record = pruner is not None and bool(tape.branches) and prunes_at(level, grid.depth)
+    state, flo, fhi, classified, inside, choices = _child_states(tape, grid, level, parents,
+                                                                 dtype, record)
     kids = ((parents << _THREE)[None, :] | _SLOTS[:, None]).reshape(-1)
     if mean_value or exact is not None:
         amb = np.flatnonzero(state == AMBIGUOUS)
         if amb.size:
             # the natural bounds are known: only the boxes are rebuilt, as columns
             box_lo, box_hi = grid.octant_boxes(level + 1, _unpack(kids[amb]))
-            state[amb] = _tighten(func, box_lo, box_hi, flo[amb].astype(np.float64),
+            state[amb] = _tighten(tape, box_lo, box_hi, flo[amb].astype(np.float64),
                                   fhi[amb].astype(np.float64), state[amb], exact, mean_value)
     ambiguous = state == AMBIGUOUS
-    suspects = _NONE
+    suspects: list = []
+
+    def groups(mask: np.ndarray) -> list:
+        which = np.flatnonzero(mask)
+        if not len(which):
+            return []
+        if not record:
+            return [(kids[which], tape)]
+        return [(kids[members], pruned) for members, pruned in
+                pruner.groups(tape, choices, which, kids[which], grid.depth - level - 1)]
+
     if recheck > 0.0 and exact is None and level + 1 == grid.depth:
         near_end = suspect_voxels(flo, fhi, len(parents), recheck, inside)
         near_end &= ambiguous
-        suspects = kids[np.flatnonzero(near_end)]
+        suspects = groups(near_end)
         ambiguous &= ~near_end
-    return (kids[np.flatnonzero(ambiguous)],
-            kids[np.flatnonzero(state == FULL)] if full else None, suspects, classified)
-
-
-_NONE = np.zeros(0, dtype=np.uint64)
+    return (groups(ambiguous), kids[np.flatnonzero(state == FULL)] if full else None, suspects,
+            classified)
 
 
 def suspect_voxels(flo: np.ndarray, fhi: np.ndarray, m: int, recheck: float,
@@ -292,7 +338,7 @@ def suspect_voxels(flo: np.ndarray, fhi: np.ndarray, m: int, recheck: float,
         return np.minimum(-flo, fhi) <= margin
 
 
-def recheck_voxels(func: Function, grid: Grid, codes: np.ndarray, dtype
+def recheck_voxels(tape: Tape, grid: Grid, codes: np.ndarray, dtype
                    ) -> tuple[np.ndarray, np.ndarray, int]:
     """Settle suspect voxels (Morton codes at ``grid.depth``) on their 8 sub-voxels.
 
@@ -303,12 +349,13 @@ def recheck_voxels(func: Function, grid: Grid, codes: np.ndarray, dtype
     stays AMBIGUOUS if one of them is, and is FULL (EMPTY) if all are, since
     any two halves share a point and a FULL one cannot touch an EMPTY one.
     This is ``subvoxel=1`` (Stolte's sub-voxel refinement) on the few voxels
-    it can change: as sound, and cheap. ``dtype``: the voxels' float type.
+    it can change: as sound, and cheap. ``dtype``: the voxels' float type;
+    ``tape``: one valid over all the voxels (the function's, or their pruned one).
     Returns ``(still AMBIGUOUS, FULL, boxes classified)``.
     """
     fine = grid.finer(1)
     sub_dtype = level_dtype(fine, fine.depth) if np.dtype(dtype) == np.float32 else np.float64
-    state, _, _, classified, _ = _child_states(func, fine, grid.depth, codes, sub_dtype)
+    state, _, _, classified, _, _ = _child_states(tape, fine, grid.depth, codes, sub_dtype)
     state = state.reshape(8, -1)
     met = (state == AMBIGUOUS).any(axis=0)
     inside = (state == FULL).all(axis=0)
@@ -341,10 +388,10 @@ class _Progress:
     def estimate(self, m: int, level: int) -> float:
         return 8.0 * m * (4.0 ** (self.depth - level) - 1.0) / 3.0
 
-    def report(self, stack: list) -> None:
+    def report(self, frontier: Frontier) -> None:
         if self.hook is None:
             return
-        pending = sum(self.estimate(len(c), lvl) for lvl, c in stack)
+        pending = sum(self.estimate(count, lvl) for lvl, count in frontier.sizes())
         share = self.done / (self.done + pending) if pending else 1.0
         self.last = max(self.last, min(share, 1.0))
         self.hook(self.last)
@@ -353,7 +400,8 @@ class _Progress:
 def subdivide(func: Function, grid: Grid, *, start: Optional[tuple[int, np.ndarray]] = None,
               interior: bool = False, exact=None, progress=None, chunk: int = CHUNK,
               mean_value: bool = False, exact_voxels=None,
-              recheck: float = RECHECK, guard: Optional[MemoryGuard] = None) -> Subdivision:
+              recheck: float = RECHECK, guard: Optional[MemoryGuard] = None,
+              prune: bool = True, leaf_level: Optional[int] = None) -> Subdivision:
     """Classify octants from the root (or from ``start``) down to the voxels.
 
     Parameters
@@ -384,14 +432,26 @@ def subdivide(func: Function, grid: Grid, *, start: Optional[tuple[int, np.ndarr
     guard : MemoryGuard, optional
         Asked after every step with the surface voxels kept and the octants
         pending or interior; it stops the run (``MemoryError``) past its budget.
+    prune : bool, default: True
+        Evaluate each subtree with the tape pruned by the branch choices its
+        octants settled (:mod:`implicitvox.eval.pruning`); the result is
+        bit-identical either way, only faster.
+    leaf_level : int, optional
+        The level whose tapes :attr:`Subdivision.tapes` reports (default: the
+        voxels; the voxelizer's ``subvoxel`` runs pass the coarser voxels' level).
     """
     depth = grid.depth
+    leaf_level = depth if leaf_level is None else leaf_level
     per_step = max(1, chunk // 8)
     if exact_voxels is None:
         exact_voxels = exact
-    surface: list[np.ndarray] = []
+    pruner = Pruner() if prune else None
+    base = func.tape
+    # the surface voxels as parts (codes, tape valid over their leaf_level octants)
+    surface: list[tuple[np.ndarray, Tape]] = []
     interior_parts: dict[int, list[np.ndarray]] = {}
-    stack: list[tuple[int, np.ndarray]] = []
+    # pending octants, with the tape valid over them and that of their leaf_level octant
+    frontier = Frontier()
     evaluated = 0
     if start is None:
         root = np.zeros((1, 3), dtype=np.int32)
@@ -401,66 +461,80 @@ def subdivide(func: Function, grid: Grid, *, start: Optional[tuple[int, np.ndarr
             interior_parts[0] = [_pack(root)]
         elif state[0] == AMBIGUOUS:
             if depth == 0:
-                surface.append(_pack(root))
+                surface.append((_pack(root), base))
             else:
-                stack.append((0, _pack(root)))
+                frontier.push(0, _pack(root), base, base if leaf_level == 0 else None)
     else:
         level0, coords0 = start
-        keys0 = _pack(coords0)
-        stack.extend((level0, keys0[s:s + per_step]) for s in range(0, len(keys0), per_step))
+        frontier.push(level0, _pack(coords0), base, base if level0 >= leaf_level else None)
     meter = _Progress(progress, depth)
-    single = supports_float32(func.tape)
+    single = supports_float32(base)
     voxel_dtype = level_dtype(grid, depth) if single else np.float64
-    suspects: list[np.ndarray] = []
+    suspects: list[tuple[np.ndarray, Tape, Tape]] = []
     pending = 0
-    kept = sum(len(c) for c in surface)
-    held = sum(len(k) for _, k in stack)   # pending and interior octant keys
+    kept = sum(len(c) for c, _ in surface)
+    held = len(frontier)   # pending and interior octant keys
 
     def settle_suspects() -> int:
-        codes = np.concatenate(suspects)
+        classified = 0
+        for codes, tape, leaf_tape in _by_tapes(suspects):
+            met, full, count = recheck_voxels(tape, grid, codes, voxel_dtype)
+            classified += count
+            surface.append((met, leaf_tape))
+            nonlocal kept
+            kept += len(met)
+            if interior and len(full):
+                interior_parts.setdefault(depth, []).append(full)
         suspects.clear()
-        met, full, classified = recheck_voxels(func, grid, codes, voxel_dtype)
-        surface.append(met)
-        nonlocal kept
-        kept += len(met)
-        if interior and len(full):
-            interior_parts.setdefault(depth, []).append(full)
         return classified
 
-    while stack:
-        level, parents = stack.pop()
+    while frontier:
+        level, parents, tape, leaf_tape = frontier.pop(per_step)
         held -= len(parents)
         ambiguous, full, suspect, classified = classify_children(
-            func, grid, level, parents, exact_voxels if level + 1 == depth else exact, mean_value,
+            tape, grid, level, parents, exact_voxels if level + 1 == depth else exact, mean_value,
             level_dtype(grid, level + 1) if single else np.float64, full=interior,
-            recheck=recheck)
+            recheck=recheck, pruner=pruner)
         if full is not None and len(full):
             interior_parts.setdefault(level + 1, []).append(full)
             held += len(full)
-        if len(suspect):   # rechecked in batches, for full-sized evaluations
-            suspects.append(suspect)
-            pending += len(suspect)
-            if pending >= per_step or not stack:
-                classified += settle_suspects()
-                pending = 0
+        for codes, pruned in suspect:   # rechecked in batches, for full-sized evaluations
+            suspects.append((codes, pruned, pruned if level + 1 == leaf_level else leaf_tape))
+            pending += len(codes)
+        if suspects and (pending >= per_step or not frontier):
+            classified += settle_suspects()
+            pending = 0
         evaluated += classified
         meter.done += classified
-        if level + 1 == depth:
-            surface.append(ambiguous)
-            kept += len(ambiguous)
-        elif len(ambiguous):
-            stack.extend((level + 1, ambiguous[s:s + per_step])
-                         for s in range(0, len(ambiguous), per_step))
-            held += len(ambiguous)
+        for codes, pruned in ambiguous:
+            at_leaf = pruned if level + 1 == leaf_level else leaf_tape
+            if level + 1 == depth:
+                surface.append((codes, at_leaf))
+                kept += len(codes)
+            else:
+                frontier.push(level + 1, codes, pruned, at_leaf)
+                held += len(codes)
         if guard is not None:
             guard.check(kept + pending, held)
-        meter.report(stack)
+        meter.report(frontier)
     if suspects:
         evaluated += settle_suspects()
     if progress is not None:
         progress(1.0)
+    runs = [(codes, base if tape is None else tape) for codes, tape, _ in
+            _by_tapes([(c, t, t) for c, t in surface])]
     return Subdivision(
-        codes=np.concatenate(surface) if surface else np.zeros(0, dtype=np.uint64),
-        interior={lvl: _unpack(np.concatenate(parts))
+        codes=np.concatenate([c for c, _ in runs]) if runs else np.zeros(0, dtype=np.uint64),
+        interior={lvl: _unpack(np.sort(np.concatenate(parts)))   # Morton order: any schedule
                   for lvl, parts in sorted(interior_parts.items())},
-        evaluated=evaluated)
+        evaluated=evaluated, tapes=[(len(c), t) for c, t in runs],
+        tapes_built=pruner.built if pruner is not None else 0)
+
+
+def _by_tapes(parts: list) -> list:
+    """Parts ``(codes, tape, leaf_tape)`` merged where both tapes are the same objects."""
+    merged: dict[tuple[int, int], tuple[list, Any, Any]] = {}
+    for codes, tape, leaf_tape in parts:
+        merged.setdefault((id(tape), id(leaf_tape)), ([], tape, leaf_tape))[0].append(codes)
+    return [(np.concatenate(c) if len(c) > 1 else c[0], tape, leaf_tape)
+            for c, tape, leaf_tape in merged.values()]

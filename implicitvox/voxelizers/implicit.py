@@ -21,6 +21,7 @@ from .. import batches
 from .. import validate
 from ..version import __version__
 from ..eval.function import Function
+from ..eval.gradient import evaluate_gradients
 from ..expr.shape import as_shape, exact_classifier, voxel_classifier
 from ..octree import morton
 from ..octree.grid import Grid, padded_bounds
@@ -64,7 +65,8 @@ def grid_of(shape_bounds: Any, bounds: Any, resolution: Any, voxel_size: Any,
     return Grid.from_bounds(bounds, resolution, voxel_size)
 
 
-def estimate_memory(func: Function, grid: Grid, normals: bool = False) -> tuple[int, int]:
+def estimate_memory(func: Function, grid: Grid, normals: bool = False, prune: bool = True
+                    ) -> tuple[int, int]:
     """Estimated surface voxels and peak bytes of a voxelization.
 
     A pilot subdivision to depth ``min(depth, 6)`` counts the AMBIGUOUS
@@ -78,7 +80,7 @@ def estimate_memory(func: Function, grid: Grid, normals: bool = False) -> tuple[
                  tuple(-(-n // scale) for n in grid.shape))
     # The pilot's voxels are unions of grid voxels; crop effects are ignored.
     # No recheck: the pilot is cheaper and its count an upper estimate.
-    found = len(subdivide(func, pilot, recheck=0.0).codes)
+    found = len(subdivide(func, pilot, recheck=0.0, prune=prune).codes)
     cells = int(np.prod(grid.shape, dtype=np.float64))
     voxels = min(found * 4 ** (depth - pilot_depth), cells)
     return int(voxels), int(voxels * bytes_per_voxel(normals) + working_bytes(grid))
@@ -97,17 +99,32 @@ def bytes_per_voxel(normals: bool) -> int:
     return _BYTES_PER_VOXEL + (_BYTES_PER_NORMAL if normals else 0)
 
 
-def voxel_normals(func: Function, grid: Grid, coords: np.ndarray) -> np.ndarray:
-    """Unit gradients at voxel centres (Stolte §2), float32; zero where undefined."""
+def voxel_normals(func: Function, grid: Grid, coords: np.ndarray,
+                  tapes: Optional[list] = None) -> np.ndarray:
+    """Unit gradients at voxel centres (Stolte §2), float32; zero where undefined.
+
+    ``tapes``: runs ``(count, tape)`` over ``coords`` of tapes valid over the
+    voxels (the pruned tapes :attr:`Subdivision.tapes`; the same gradients,
+    bit for bit, in fewer operations); default the function's own tape."""
     out = np.zeros((len(coords), 3), dtype=np.float32)
-    for s in range(0, len(coords), _NORMALS_CHUNK):
-        c = grid.centers(coords[s:s + _NORMALS_CHUNK])
-        _, g = func.gradient(c[:, 0], c[:, 1], c[:, 2])
-        norm = np.linalg.norm(g, axis=1, keepdims=True)
-        with np.errstate(invalid="ignore", divide="ignore"):
-            unit = np.where((norm > 0) & np.isfinite(norm), g / norm, 0.0)
-        out[s:s + _NORMALS_CHUNK] = unit
+    runs = tapes if tapes is not None else [(len(coords), func.tape)]
+    start = 0
+    for count, tape in runs:
+        for s in range(start, start + count, _NORMALS_CHUNK):
+            e = min(s + _NORMALS_CHUNK, start + count)
+            c = grid.centers(coords[s:e])
+            _, g = evaluate_gradients(tape, c[:, 0], c[:, 1], c[:, 2])
+            out[s:e] = unit_vectors(g.T)
+        start += count
     return out
+
+
+def unit_vectors(g: np.ndarray) -> np.ndarray:
+    """Rows of ``g`` (n, 3) scaled to unit length, float32; zero where the length is
+    zero or not finite."""
+    norm = np.linalg.norm(g, axis=1, keepdims=True)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return np.where((norm > 0) & np.isfinite(norm), g / norm, 0.0).astype(np.float32)
 
 
 class ImplicitSource:
@@ -131,9 +148,7 @@ class ImplicitSource:
     def normals_at(self, points: np.ndarray) -> np.ndarray:
         """Unit gradients of the shape's function at ``points`` (n, 3)."""
         _, g = self.func.gradient(points[:, 0], points[:, 1], points[:, 2])
-        norm = np.linalg.norm(g, axis=1, keepdims=True)
-        with np.errstate(invalid="ignore", divide="ignore"):
-            return np.where((norm > 0) & np.isfinite(norm), g / norm, 0.0).astype(np.float32)
+        return unit_vectors(g)
 
     def __repr__(self) -> str:
         return f"<ImplicitSource {self.shape!r:.60}>"
@@ -144,7 +159,7 @@ def voxelize(shape: Any, resolution: Union[int, tuple[int, int, int], None] = No
              interior: bool = False, normals: bool = False,
              progress: Optional[Callable[[float], Any]] = None,
              max_memory: Optional[int] = None, mean_value: bool = False,
-             subvoxel: int = 0, recheck: float = RECHECK) -> Voxels:
+             subvoxel: int = 0, recheck: float = RECHECK, prune: bool = True) -> Voxels:
     """Voxelize a shape: every voxel whose closed box the surface meets is output.
 
     Interval arithmetic rejects octants the surface cannot meet and
@@ -189,6 +204,12 @@ def voxelize(shape: Any, resolution: Union[int, tuple[int, int, int], None] = No
         the voxels predicted to be settled (about 10% of them, adding about
         30% to the time); larger values recheck more, up to nearly all at 4;
         0 turns it off. Ignored for shapes with an exact voxel test.
+    prune : bool, default: True
+        Evaluate each region with the expression pruned to the branches of
+        ``min``, ``max`` and ``abs`` that can still matter there
+        (:mod:`implicitvox.eval.pruning`): a union of many parts costs, near
+        each voxel, about what the parts near it cost. The voxels, interior
+        and normals are bit-identical with ``prune=False``.
 
     Returns
     -------
@@ -207,7 +228,8 @@ def voxelize(shape: Any, resolution: Union[int, tuple[int, int, int], None] = No
                "normals": validate.boolean(normals, "normals"),
                "mean_value": validate.boolean(mean_value, "mean_value"),
                "subvoxel": validate.int_in(subvoxel, "subvoxel", 0, 4),
-               "recheck": validate.number_in(recheck, "recheck", 0.0, 4.0)}
+               "recheck": validate.number_in(recheck, "recheck", 0.0, 4.0),
+               "prune": validate.boolean(prune, "prune")}
     grid = grid_of(getattr(shape, "bounds", None), bounds, resolution, voxel_size)
     if grid.depth + options["subvoxel"] > 21:
         raise ValueError(f"resolution {grid.shape} with subvoxel={subvoxel} exceeds the octree's "
@@ -221,7 +243,8 @@ def _run(source: ImplicitSource, grid: Grid, progress, start, interior_before,
          budget: int) -> Voxels:
     """Estimate, refuse over the budget, then subdivide under a guard of the same budget."""
     shape, func, options = source.shape, source.func, source.options
-    estimated_voxels, estimated_bytes = estimate_memory(func, grid, options["normals"])
+    estimated_voxels, estimated_bytes = estimate_memory(func, grid, options["normals"],
+                                                        options["prune"])
     what = f"voxelizing at {grid.shape}"
     refuse_over_budget(estimated_bytes, budget, f"{what} (~{estimated_voxels:,} surface voxels)")
     guard = MemoryGuard(budget, what, bytes_per_voxel(options["normals"]),
@@ -233,7 +256,7 @@ def _run(source: ImplicitSource, grid: Grid, progress, start, interior_before,
     _warn_if_useless(len(result.codes), grid)
     payload = {}
     if options["normals"]:
-        payload["normals"] = voxel_normals(func, grid, result.surface)
+        payload["normals"] = voxel_normals(func, grid, result.surface, result.tapes)
     tree = Octree.from_codes(result.codes, grid.depth, payload)
     interior = dict(interior_before or {})
     for level, coords in result.interior.items():
@@ -243,6 +266,7 @@ def _run(source: ImplicitSource, grid: Grid, progress, start, interior_before,
         "seconds_subdivide": t1 - t0,
         "seconds_total": time.perf_counter() - t0,
         "boxes_evaluated": result.evaluated,
+        "tapes_built": result.tapes_built,
         "estimated_voxels": estimated_voxels,
         "implicitvox": __version__,
     }
@@ -268,10 +292,17 @@ def _subdivide(func, grid, options, exact, progress, start, guard):
     result = subdivide(func, grid.finer(s) if s else grid, start=start,
                        interior=options["interior"], exact=exact_boxes, progress=progress,
                        mean_value=options["mean_value"], exact_voxels=exact_voxels,
-                       recheck=options["recheck"], guard=guard)
+                       recheck=options["recheck"], guard=guard, prune=options["prune"],
+                       leaf_level=grid.depth)
     if not s:
         return result
-    result.codes = np.unique(result.codes >> np.uint64(3 * s))   # the voxels holding them
+    # the voxels holding them, each with the tape of one of its sub-voxels (all have the voxel's)
+    run_of = np.repeat(np.arange(len(result.tapes)), [n for n, _ in result.tapes])
+    result.codes, first = np.unique(result.codes >> np.uint64(3 * s), return_index=True)
+    order = np.argsort(run_of[first], kind="stable")
+    result.codes = result.codes[order]
+    counts = np.bincount(run_of[first], minlength=len(result.tapes))
+    result.tapes = [(int(c), t) for c, (_, t) in zip(counts, result.tapes) if c]
     result.interior = _interior_from_subvoxels(result.interior, grid, s)
     return result
 
@@ -290,7 +321,9 @@ def _interior_from_subvoxels(interior, grid, s):
         codes = morton.encode(np.concatenate(voxels))
         uniq, inverse = np.unique(codes, return_inverse=True)
         covered = np.bincount(inverse, weights=np.concatenate(weights))
-        whole = morton.decode(uniq[covered == 8 ** s]).astype(np.int32)
+        whole = uniq[covered == 8 ** s]
         if len(whole):
-            kept[depth] = np.concatenate([kept[depth], whole]) if depth in kept else whole
+            if depth in kept:   # the union, in Morton order
+                whole = np.sort(np.concatenate([morton.encode(kept[depth]), whole]))
+            kept[depth] = morton.decode(whole).astype(np.int32)
     return kept

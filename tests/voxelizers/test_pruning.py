@@ -1,0 +1,93 @@
+"""Pruning changes nothing in the result: voxels, interior and normals are
+bit-identical with and without it (digests), on the never-miss models, the
+OpenSCAD fixtures, the many-part examples and random CSG trees."""
+from __future__ import annotations
+
+import hashlib
+from pathlib import Path
+
+import numpy as np
+import pytest
+from hypothesis import given, settings, strategies as st
+
+import implicitvox as ivx
+from csg import Box, Cylinder, Sphere, read_openscad
+from implicitvox.expr.examples import drilled_plate, menger, sphere_union
+from tests.properties.test_never_misses import MODELS
+
+FIXTURES = Path(__file__).resolve().parents[1] / "openscad"
+RES = 40
+
+
+def _digest(vox) -> str:
+    h = hashlib.sha256(vox.coords().tobytes())
+    for level in sorted(vox.interior):
+        h.update(f"{level}:".encode() + np.ascontiguousarray(vox.interior[level]).tobytes())
+    if vox.normals is not None:
+        h.update(vox.normals.tobytes())
+    return h.hexdigest()
+
+
+def _both(shape, res=RES, **options):
+    pruned = ivx.voxelize(shape, res, prune=True, **options)
+    whole = ivx.voxelize(shape, res, prune=False, **options)
+    assert whole.metadata["tapes_built"] == 0
+    assert pruned.count == whole.count
+    assert _digest(pruned) == _digest(whole)
+    return pruned
+
+
+@pytest.mark.parametrize("name", sorted(MODELS))
+def test_never_miss_models(name):
+    expr, bounds, _ = MODELS[name]()
+    _both(expr, bounds=bounds, interior=True, normals=True)
+
+
+@pytest.mark.parametrize("options", [{"mean_value": True}, {"subvoxel": 1, "normals": True},
+                                     {"recheck": 4.0}, {"recheck": 0.0, "interior": True}])
+@pytest.mark.parametrize("name", ["csg-box-minus-ball", "gear", "polar-teeth"])
+def test_options(name, options):
+    expr, bounds, _ = MODELS[name]()
+    _both(expr, bounds=bounds, **options)
+
+
+@pytest.mark.parametrize("model", sorted(p.stem for p in FIXTURES.glob("*.csg")))
+def test_openscad_fixtures(model):
+    _both(read_openscad(FIXTURES / f"{model}.csg"), interior=True, normals=True)
+
+
+@pytest.mark.parametrize("shape", [menger(2), sphere_union(40), drilled_plate(6, 6)],
+                         ids=["menger", "spheres", "drilled-plate"])
+def test_many_part_models_are_pruned_and_identical(shape):
+    vox = _both(shape, 64, interior=True, normals=True)
+    assert vox.metadata["tapes_built"] > 0, "nothing was pruned"
+
+
+@st.composite
+def solids(draw):
+    """Random unions, intersections and differences of 2-50 csg primitives."""
+    coord = st.floats(-1.0, 1.0, allow_nan=False)
+    size = st.floats(0.1, 0.8, allow_nan=False)
+    parts = []
+    for _ in range(draw(st.integers(2, 50))):
+        centre = tuple(draw(coord) for _ in range(3))
+        kind = draw(st.sampled_from(["sphere", "box", "cylinder"]))
+        if kind == "sphere":
+            part = Sphere(draw(size), center=centre)
+        elif kind == "box":
+            part = Box(tuple(draw(size) for _ in range(3)), center=True).translate(centre)
+        else:
+            part = Cylinder(h=draw(size), r=draw(size) / 2, center=True).translate(centre)
+        parts.append(part)
+    while len(parts) > 1:
+        k = draw(st.integers(0, len(parts) - 2))
+        a, b = parts[k], parts.pop(k + 1)
+        parts[k] = draw(st.sampled_from([a | b, a & b, a - b]))
+    return parts[0]
+
+
+@settings(max_examples=12, deadline=None)
+@given(solids())
+def test_random_csg_trees(solid):
+    bounds = ((-1.5,) * 3, (1.5,) * 3)
+    _both(solid, 24, bounds=bounds, interior=True, normals=True)
