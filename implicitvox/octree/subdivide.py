@@ -46,7 +46,8 @@ from ..expr.shape import AMBIGUOUS, EMPTY, FULL
 from .. import batches
 
 __all__ = ["subdivide", "Subdivision", "classify", "classify_children", "suspect_voxels",
-           "recheck_voxels", "prunes_at", "CHUNK", "RECHECK", "PRUNE_EVERY", "PRUNE_MIN_BELOW"]
+           "recheck_voxels", "prunes_at", "CHUNK", "RECHECK", "PRUNE_EVERY", "PRUNE_MIN_BELOW",
+           "PRUNE_MIN_LENGTH"]
 
 #: octants classified per interval evaluation
 CHUNK = batches.FRONTIER
@@ -59,6 +60,8 @@ _CHILD_OFFSETS = morton.CORNERS.astype(np.int32)
 #: voxels (:func:`prunes_at`)
 PRUNE_EVERY = 2
 PRUNE_MIN_BELOW = 3
+#: tapes shorter than this are not pruned further (:func:`prunes_at`)
+PRUNE_MIN_LENGTH = 128
 
 
 @dataclass
@@ -231,15 +234,17 @@ def _child_states(tape: Tape, grid: Grid, level: int, parents: np.ndarray, dtype
     return state, flo, fhi, classified, inside, choices
 
 
-def prunes_at(level: int, depth: int) -> bool:
+def prunes_at(level: int, depth: int, length: int) -> bool:
     """Whether the choices over the children of octants at ``level`` are recorded to
-    prune their subtrees' tapes: every :data:`PRUNE_EVERY` levels, and only where
-    :data:`PRUNE_MIN_BELOW` levels at least lie below the children. Recording
-    costs about a third of an evaluation, and the deepest levels hold most
-    boxes; pruning there would split the frontier into batches too small for
-    numpy (measured in tests/benchmarks/bench_pruning.py)."""
+    prune their subtrees' tapes of ``length`` instructions: every
+    :data:`PRUNE_EVERY` levels, only where :data:`PRUNE_MIN_BELOW` levels at
+    least lie below the children, and for tapes of :data:`PRUNE_MIN_LENGTH`
+    instructions or more. Recording costs about a third of an evaluation, the
+    deepest levels hold most boxes, and a short tape gains less than the
+    smaller batches cost: pruning there would split the frontier into batches
+    too small for numpy (measured in tests/benchmarks/bench_pruning.py)."""
     below = depth - level - 1
-    return below >= PRUNE_MIN_BELOW and below % PRUNE_EVERY == 0
+    return length >= PRUNE_MIN_LENGTH and below >= PRUNE_MIN_BELOW and below % PRUNE_EVERY == 0
 
 
 def classify_children(tape: Tape, grid: Grid, level: int, parents: np.ndarray,
@@ -262,7 +267,8 @@ def classify_children(tape: Tape, grid: Grid, level: int, parents: np.ndarray,
     groups ``(codes, tape)``, ``full`` codes or None unless asked for,
     ``classified`` the number of boxes classified.
     """
-    record = pruner is not None and bool(tape.branches) and prunes_at(level, grid.depth)
+    record = pruner is not None and bool(tape.branches) and prunes_at(level, grid.depth,
+                                                                      len(tape))
     state, flo, fhi, classified, inside, choices = _child_states(tape, grid, level, parents,
                                                                  dtype, record)
     kids = ((parents << _THREE)[None, :] | _SLOTS[:, None]).reshape(-1)

@@ -37,6 +37,13 @@ from implicitvox.expr.examples import drilled_plate, menger, sphere_union
 from implicitvox.octree.grid import Grid
 from implicitvox.octree.subdivide import subdivide
 
+try:
+    from tests.benchmarks import tables
+except ImportError:        # run as a script from elsewhere
+    import sys
+    sys.path.insert(0, str(__import__("pathlib").Path(__file__).resolve().parents[2]))
+    from tests.benchmarks import tables
+
 
 def _load() -> str:
     return "/".join(f"{v:.2f}" for v in os.getloadavg())
@@ -101,7 +108,8 @@ def main() -> None:
     parser.add_argument("--quick", action="store_true", help="at most 512^3, no N = 1000")
     parser.add_argument("--profile", action="store_true")
     args = parser.parse_args()
-    print(f"load average before: {_load()}  ({os.cpu_count()} cpus)")
+    load_before = _load()
+    print(f"load average before: {load_before}  ({os.cpu_count()} cpus)")
     print(f"{'model':<22}{'res':>6}{'voxels':>11}{'pruned':>9}{'whole':>9}{'x':>8}"
           f"{'us/v p':>9}{'us/v w':>9}{'tapes':>7}{'leaf~':>7}{'max':>6}{'whole':>7}")
     rows = []
@@ -118,12 +126,27 @@ def main() -> None:
                                 1 if res >= 1024 else args.repeat))
     rows.append(compare("drilled plate 20x20", drilled_plate(20, 20), 256, args.repeat))
     rows.append(compare("menger 3 +normals", menger(3), 256, 1, {"normals": True}))
+    shares = {}
     if args.profile:
         for prune in (False, True):
             seconds, share = kernel_share(menger(3), 512, prune)
+            shares[prune] = share
             print(f"cProfile menger 3 at 512^3, prune={prune}: {seconds:.1f} s profiled, "
                   f"{share:.0%} in the interval kernels")
     print(f"load average after: {_load()}")
+    header = ["model", "resolution", "voxels", "pruned", "whole tape", "speed-up",
+              "µs per voxel (pruned, whole)", "leaf tape: median, max (whole)"]
+    table = [[r["label"], f"{r['res']}³", f"{r['voxels']:,}", f"{r['pruned']:.2f} s",
+              f"{r['whole']:.2f} s", f"{r['speedup']:.1f}×",
+              f"{1e6 * r['pruned'] / r['voxels']:.2f}, {1e6 * r['whole'] / r['voxels']:.2f}",
+              f"{r['median']:.0f}, {r['max']} ({r['whole_len']})"] for r in rows]
+    if shares:
+        table.append(["menger 3, cProfile", "512³", "", "", "", "",
+                      f"interval kernels: {shares[True]:.0%} of the time pruned, "
+                      f"{shares[False]:.0%} whole", ""])
+    command = "python tests/benchmarks/bench_pruning.py" + (" --quick" if args.quick else "") \
+        + (" --profile" if args.profile else "")
+    tables.write("pruning", header, table, command, load_before)
 
 
 if __name__ == "__main__":

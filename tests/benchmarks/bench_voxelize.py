@@ -21,6 +21,7 @@ The interval evaluation runs in float32 for these models at every level
 from __future__ import annotations
 
 import argparse
+import os
 import time
 
 import numpy as np
@@ -29,6 +30,13 @@ import implicitvox as ivx
 from implicitvox.expr.examples import sinsin
 from implicitvox.octree.grid import Grid
 from implicitvox.octree.precision import interval_dtype
+
+try:
+    from tests.benchmarks import tables
+except ImportError:        # run as a script from elsewhere
+    import sys
+    sys.path.insert(0, str(__import__("pathlib").Path(__file__).resolve().parents[2]))
+    from tests.benchmarks import tables
 
 MODELS = [(3, 4), (5, 6), (9, 10), (9, 18)]
 
@@ -78,6 +86,10 @@ def main() -> None:
                              "its page faults)")
     args = parser.parse_args()
     resolutions = [r for r in (128, 256, 512, 1024, 2048) if r <= args.max_res]
+    load_before = "/".join(f"{v:.2f}" for v in os.getloadavg())
+    counts: dict = {}
+    speedups: dict = {}
+    tight: dict = {}
 
     print("== voxelization (defaults, single process) ==")
     print(f"{'n,m':>6}{'res':>6}{'fp':>9}{'seconds':>9}{'voxels':>12}{'octree B':>12}{'B/vox':>7}"
@@ -92,6 +104,7 @@ def main() -> None:
                 vox = ivx.voxelize(sinsin(n, m), resolution=res)
                 dt = min(dt, time.perf_counter() - t)
             timings[(n, m, res)] = dt
+            counts[(n, m, res)] = vox.count
             growth = (f"{dt / prev[0]:6.2f}{vox.count / prev[1]:7.2f}" if prev else " " * 13)
             fp = interval_dtype(ivx.compile(sinsin(n, m).expr).tape, vox.grid).name
             print(f"{n},{m:>3}{res:>6}{fp:>9}{dt:>9.2f}{vox.count:>12,}{vox.octree.nbytes:>12,}"
@@ -118,6 +131,7 @@ def main() -> None:
                 bare = min(bare, time.perf_counter() - t)
             print(f"{n},{m:>3}{res:>6}{dense_s:>9.2f}{ours:>9.2f}{dense_s / ours:>10.1f}{count:>12,}"
                   f"{bare:>14.2f}")
+            speedups[(n, m, res)] = dense_s / ours
 
     print(f"\n== tightness at {args.tight_res}^3: share of voxels with a sampled sign change ==")
     variants = [("defaults", {}), ("recheck=0", {"recheck": 0.0}),
@@ -132,8 +146,31 @@ def main() -> None:
             t = time.perf_counter()
             vox = ivx.voxelize(sinsin(n, m), resolution=args.tight_res, **options)
             dt = time.perf_counter() - t
-            cells.append(f"{tightness(func, vox):.3f} ({dt:5.1f}s)")
+            share = tightness(func, vox)
+            tight[(n, m, options.get("recheck"), len(options))] = share
+            cells.append(f"{share:.3f} ({dt:5.1f}s)")
         print(f"{n},{m:>3}" + "".join(f"{c:>18}" for c in cells))
+    _write_table(args, resolutions, timings, counts, speedups, tight, load_before)
+
+
+def _write_table(args, resolutions, timings, counts, speedups, tight, load_before) -> None:
+    """The README's table: the two largest resolutions, their growth, the dense
+    baseline at the largest dense resolution, the tightness with and without recheck."""
+    top, big = resolutions[-2:] if len(resolutions) > 1 else resolutions * 2
+    dense = max(args.dense) if args.dense else None
+    header = ["(n, m)", f"{top}³", f"{big}³",
+              f"voxels ×, time × per doubling ({top}³→{big}³)",
+              f"vs dense corner signs at {dense}³", f"tightness at {args.tight_res}³ "
+              "(without recheck)"]
+    rows = []
+    for n, m in MODELS:
+        t0, t1 = timings[(n, m, top)], timings[(n, m, big)]
+        growth = f"×{counts[(n, m, big)] / counts[(n, m, top)]:.2f}, ×{t1 / t0:.1f}"
+        rows.append([f"({n}, {m})", f"{t0:.2f} s", f"{t1:.2f} s", growth,
+                     f"{speedups[(n, m, dense)]:.0f}×" if dense else "",
+                     f"{tight[(n, m, None, 0)]:.2f} ({tight[(n, m, 0.0, 1)]:.2f})"])
+    tables.write("voxelize", header, rows, "python tests/benchmarks/bench_voxelize.py "
+                 f"--max-res {args.max_res}", load_before)
 
 
 if __name__ == "__main__":

@@ -13,10 +13,21 @@ from hypothesis import given, settings, strategies as st
 import implicitvox as ivx
 from csg import Box, Cylinder, Sphere, read_openscad
 from implicitvox.expr.examples import drilled_plate, menger, sphere_union
+from implicitvox.octree import subdivide as subdivision
 from tests.properties.test_never_misses import MODELS
 
 FIXTURES = Path(__file__).resolve().parents[1] / "openscad"
 RES = 40
+
+
+@pytest.fixture(autouse=True)
+def prune_every_tape(monkeypatch):
+    """Prune tapes of any length at every level above the voxels (the defaults leave
+    short tapes and the last levels alone, for speed), so these small models and
+    grids exercise the pruned paths."""
+    monkeypatch.setattr(subdivision, "PRUNE_MIN_LENGTH", 0)
+    monkeypatch.setattr(subdivision, "PRUNE_MIN_BELOW", 1)
+    monkeypatch.setattr(subdivision, "PRUNE_EVERY", 1)
 
 
 def _digest(vox) -> str:
@@ -40,7 +51,9 @@ def _both(shape, res=RES, **options):
 @pytest.mark.parametrize("name", sorted(MODELS))
 def test_never_miss_models(name):
     expr, bounds, _ = MODELS[name]()
-    _both(expr, bounds=bounds, interior=True, normals=True)
+    vox = _both(expr, bounds=bounds, interior=True, normals=True)
+    if any(op in repr(expr) for op in ("min(", "max(")):
+        assert vox.metadata["tapes_built"] > 0, "nothing was pruned"
 
 
 @pytest.mark.parametrize("options", [{"mean_value": True}, {"subvoxel": 1, "normals": True},
@@ -58,9 +71,11 @@ def test_openscad_fixtures(model):
 
 @pytest.mark.parametrize("shape", [menger(2), sphere_union(40), drilled_plate(6, 6)],
                          ids=["menger", "spheres", "drilled-plate"])
-def test_many_part_models_are_pruned_and_identical(shape):
+def test_many_part_models_are_pruned_and_identical(shape, monkeypatch):
     vox = _both(shape, 64, interior=True, normals=True)
     assert vox.metadata["tapes_built"] > 0, "nothing was pruned"
+    monkeypatch.undo()   # and with the default policy
+    assert _both(shape, 64).count == vox.count
 
 
 @st.composite
