@@ -27,7 +27,7 @@ _MARKED = re.compile(r"(<!-- table:(?P<name>[\w-]+) -->\n)(?P<body>.*?)(<!-- /ta
 
 
 def machine() -> str:
-    """The processor, the cores this process may use, and the load average."""
+    """The processor and the cores this process may use."""
     model = platform.processor() or "unknown processor"
     try:
         for line in Path("/proc/cpuinfo").read_text().splitlines():
@@ -37,8 +37,7 @@ def machine() -> str:
     except OSError:
         pass
     cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count()
-    load = "/".join(f"{v:.2f}" for v in os.getloadavg())
-    return f"{model}, {cores} cores, load average {load}"
+    return f"{model}, {cores} cores"
 
 
 def markdown(header: Sequence[str], rows: Sequence[Sequence[str]]) -> str:
@@ -53,8 +52,9 @@ def write(name: str, header: Sequence[str], rows: Sequence[Sequence[str]], comma
     """Write results file ``NAME.md``: the table, then how and where it was measured."""
     RESULTS.mkdir(exist_ok=True)
     today = datetime.date.today().isoformat()
-    text = (markdown(header, rows) + f"\n`{command}`, {today}, on {machine()} "
-            f"(before: {load_before}).\n")
+    load_after = "/".join(f"{v:.2f}" for v in os.getloadavg())
+    text = (markdown(header, rows) + f"\n`{command}`, {today}, on {machine()}; load average "
+            f"{load_before} before, {load_after} after.\n")
     path = RESULTS / f"{name}.md"
     path.write_text(text)
     print(f"wrote {path.relative_to(ROOT)}; copy it into the README with "
