@@ -136,9 +136,9 @@ def test_an_unexpected_error_is_one_line_unless_debug(monkeypatch, capsys):
 def test_no_prune_gives_the_same_voxels(tmp_path, capsys):
     files = []
     for flag in ([], ["--no-prune"]):
-        out_file = tmp_path / f"menger{len(flag)}.npz"
-        code, _, err = run(["voxelize", "--example", "menger", "--resolution", "32", "--quiet",
-                            "--out", str(out_file)] + flag, capsys)
+        out_file = tmp_path / f"plate{len(flag)}.npz"
+        code, _, err = run(["voxelize", "--example", "drilled-plate", "--resolution", "64",
+                            "--quiet", "--out", str(out_file)] + flag, capsys)
         assert code == 0, err
         files.append(ivx.load(str(out_file)))
     assert files[0].metadata["tapes_built"] > 0 and files[1].metadata["tapes_built"] == 0
