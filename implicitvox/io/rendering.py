@@ -116,9 +116,42 @@ def render(vox: Any, path: str, *, window_size: Sequence[int] = (1024, 768),
     plotter.camera_position = "iso"
     plotter.camera.elevation = 10
     plotter.reset_camera()
-    extent = np.subtract(vox.bounds[1], vox.bounds[0])
-    if extent.max() <= 1.5 * np.sort(extent)[1]:  # compact: fill more of the frame
-        plotter.camera.zoom(1.3)
+    if vox.count:
+        _frame(plotter, _sample_corners(vox), window_size)
     plotter.screenshot(path)
     plotter.close()
     return path
+
+
+#: the share of the window's half-width (or half-height) the model's box may fill
+FRAME_FILL = 0.92
+
+
+def _sample_corners(vox: Any, count: int = 4096) -> np.ndarray:
+    """The corners of up to ``count`` surface voxels, spread over the model (every
+    k-th in Morton order, and the extreme ones along each axis): what the picture
+    must hold."""
+    coords = vox.coords()
+    step = max(1, len(coords) // count)
+    picked = np.concatenate([coords[::step], coords[coords.argmin(axis=0)],
+                             coords[coords.argmax(axis=0)]])
+    offsets = np.array([[(k >> a) & 1 for a in range(3)] for k in range(8)])
+    lo = np.asarray(vox.grid.origin) + (picked[:, None, :] + offsets[None]) * \
+        np.asarray(vox.voxel_size)
+    return lo.reshape(-1, 3)
+
+
+def _frame(plotter: Any, points: np.ndarray, window_size: Sequence[int]) -> None:
+    """Zoom so all ``points`` show, filling :data:`FRAME_FILL` of the window along
+    its tighter direction: the points are projected with the camera (VTK's
+    composite projection), and the zoom scales them (twice, as the perspective
+    makes one step approximate)."""
+    aspect = window_size[0] / window_size[1]
+    for _ in range(2):
+        m = plotter.camera.GetCompositeProjectionTransformMatrix(aspect, -1, 1)
+        matrix = np.array([[m.GetElement(i, j) for j in range(4)] for i in range(4)])
+        projected = np.c_[points, np.ones(len(points))] @ matrix.T
+        reach = float(np.abs(projected[:, :2] / projected[:, 3:4]).max())
+        if not np.isfinite(reach) or reach <= 0:
+            return
+        plotter.camera.zoom(FRAME_FILL / reach)
