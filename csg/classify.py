@@ -7,7 +7,7 @@ similarity; any other subtree becomes one compiled implicit function). Each
 leaf classifies boxes as EMPTY, FULL or AMBIGUOUS:
 
 * a polyhedron exactly - AMBIGUOUS iff a triangle meets the closed box
-  (:class:`implicitvox.mesh.tribox.Triangles`), else FULL or EMPTY by the winding
+  (:class:`implicitvox.triangles.tribox.Triangles`), else FULL or EMPTY by the winding
   number at the box's centre;
 * boxes, convex polyhedra, half-spaces, spheres and ellipsoids (under any
   affine map), capped cylinders and cones (under similarities), tori (under
@@ -39,10 +39,10 @@ import numpy as np
 import implicitvox as iv
 from implicitvox import batches
 from implicitvox.expr.shape import AMBIGUOUS, EMPTY, FULL
-from implicitvox.mesh.crossings import RayWinding
-from implicitvox.mesh.pairs import sorted_unique
-from implicitvox.mesh.ranges import buckets, expand_boxes, gather
-from implicitvox.mesh.tribox import Triangles
+from implicitvox.triangles.crossings import RayWinding
+from implicitvox.triangles.pairs import sorted_unique
+from implicitvox.triangles.ranges import buckets, expand_boxes, gather
+from implicitvox.triangles.tribox import Triangles
 from implicitvox.octree.morton import CORNERS
 
 __all__ = ["plan", "exact_classifier", "world_primitive", "similarity_scale", "MeshClassifier",

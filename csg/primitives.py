@@ -22,7 +22,7 @@ import numpy as np
 
 import implicitvox as iv
 from implicitvox import Expr, validate, linf, x, y, z
-from implicitvox.mesh.inputs import as_triangles
+from implicitvox.triangles.inputs import as_triangles
 from implicitvox.octree.morton import CORNERS
 
 from .classify import MeshClassifier, similarity_scale
@@ -371,7 +371,7 @@ class Polyhedron(Solid):
     """Any closed triangle mesh (``vertices``, ``faces``, or a mesh file / PyVista mesh).
 
     Its geometry lives in an exact box classification (:mod:`csg.classify`:
-    the exact box-triangle test of :mod:`implicitvox.mesh.tribox`, and the
+    the exact box-triangle test of :mod:`implicitvox.triangles.tribox`, and the
     winding number for boxes off the surface). Its expression is only a
     bound - positive outside the bounding box, zero inside - which
     intervals read as "ask the exact test".

@@ -24,13 +24,14 @@ from .eval.function import Function, compile
 from .octree.grid import Grid
 from .octree.store import Octree, PointerOctree
 from .octree.voxels import Voxels
-from .mesh.bezier import BezierPatch, utah_teapot
-from .mesh.winding import winding_numbers
+from .triangles.bezier import BezierPatch, utah_teapot
+from .triangles.winding import winding_numbers
 from . import linf
 from .linf import linf_distance
 from .voxelizers.implicit import voxelize
 from .voxelizers.mesh import voxelize_mesh
 from .voxelizers.bezier import voxelize_bezier
+from .meshing.mesher import mesh
 from .io.files import load
 
 __all__ = [
@@ -38,7 +39,7 @@ __all__ = [
     "Function", "compile",
     "r", "rho", "theta", "phi", "spherical", "cylindrical", "Spherical", "Cylindrical",
     "radius", "elevation", "repeat", "repeat_polar",
-    "voxelize", "voxelize_mesh", "winding_numbers", "BezierPatch", "voxelize_bezier",
+    "voxelize", "voxelize_mesh", "mesh", "winding_numbers", "BezierPatch", "voxelize_bezier",
     "utah_teapot", "linf", "linf_distance", "Voxels", "Grid", "Octree", "PointerOctree", "load",
     "Shape", "EMPTY", "FULL", "AMBIGUOUS",
     "abs", "acos", "asin", "atan", "atan2", "clip", "cos", "exp", "floor", "hypot", "log",

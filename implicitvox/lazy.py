@@ -1,7 +1,7 @@
 """Heavy optional modules, imported on first use (``import implicitvox`` stays light).
 
-mpmath serves only the exact reference (tests); scipy only the mesh fill and
-hull constructions; neither is imported until a function touches it.
+mpmath serves only the exact reference (tests); scipy only the mesh fill, the
+hull constructions and the mesher's vertex splitting; neither is imported until a function touches it.
 
 Examples
 --------

@@ -26,7 +26,7 @@ from typing import Any, Optional, Sequence
 
 from .. import validate
 from ..expr.examples import EXAMPLES, example
-from ..mesh.inputs import MESH_SUFFIXES
+from ..triangles.inputs import MESH_SUFFIXES
 from ..octree.subdivide import RECHECK
 from ..voxelizers.implicit import voxelize
 from ..voxelizers.mesh import voxelize_mesh

@@ -22,7 +22,7 @@ from typing import Any
 import numpy as np
 
 from .. import validate
-from ..mesh.isolated import run_isolated
+from ..triangles.isolated import run_isolated
 from ..octree.grid import MAX_RESOLUTION, Grid
 from ..octree.store import Octree
 from ..octree.voxels import DEFAULT_DENSE_LIMIT, Voxels

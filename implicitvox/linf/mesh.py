@@ -12,14 +12,14 @@ For each query point:
    (:func:`~implicitvox.linf.polyhedron.triangle_distance`), and the minimum.
 
 The sign comes from the exact winding number of a closed mesh
-(:class:`~implicitvox.mesh.crossings.RayWinding`); open meshes give unsigned
+(:class:`~implicitvox.triangles.crossings.RayWinding`); open meshes give unsigned
 distances.
 
 Examples
 --------
 >>> import numpy as np
 >>> import pyvista as pv
->>> from implicitvox.mesh.inputs import as_triangles
+>>> from implicitvox.triangles.inputs import as_triangles
 >>> mesh = TriangleMesh(*as_triangles(pv.Cube()))
 >>> mesh.distance(np.array([[2.0, 0.0, 0.0], [0.0, 0.0, 0.1]])).round(12).tolist()
 [1.5, -0.4]
@@ -30,8 +30,8 @@ from typing import Any
 
 import numpy as np
 
-from ..mesh.crossings import RayWinding
-from ..mesh.inputs import as_triangles
+from ..triangles.crossings import RayWinding
+from ..triangles.inputs import as_triangles
 from ..octree import morton
 from .classify import Primitive
 from .norm import as_points, as_weights, in_blocks

@@ -36,7 +36,7 @@ import numpy as np
 from .. import validate
 from .morton import MAX_BITS
 
-__all__ = ["Grid", "padded_bounds", "MAX_RESOLUTION"]
+__all__ = ["Grid", "padded_bounds", "grid_of", "MAX_RESOLUTION"]
 
 #: voxels per axis at most (octree depth 21)
 MAX_RESOLUTION = 1 << MAX_BITS
@@ -184,3 +184,21 @@ class Grid:
             idx[:, a] = np.where(inside, m, -1)
             below[:, a] = np.where(inside & on_lower_edge & (m > 0), m - 1, idx[:, a])
         return [idx, below]
+
+
+def grid_of(shape_bounds: Any, bounds: Any, resolution: Any, voxel_size: Any,
+            what: str = "the shape") -> Grid:
+    """The grid of a run: over ``bounds``, or over the shape's own bounds padded
+    by the one rule (:func:`implicitvox.octree.grid.padded_bounds`); cubic
+    voxels unless ``resolution`` or ``voxel_size`` is given per axis.
+    ``resolution`` defaults to 256 when neither is given."""
+    if resolution is None and voxel_size is None:
+        resolution = 256
+    if resolution is not None and voxel_size is not None:
+        raise ValueError("give resolution or voxel_size, not both")
+    if bounds is None:
+        if shape_bounds is None:
+            raise ValueError(f"bounds is required: {what} has no bounds of its own; pass "
+                             "bounds=((x0, y0, z0), (x1, y1, z1))")
+        bounds = padded_bounds(shape_bounds, resolution, voxel_size)
+    return Grid.from_bounds(bounds, resolution, voxel_size)

@@ -1,8 +1,8 @@
 """``voxelize_bezier``: every voxel a Bézier patch meets (Stolte §4.2).
 
 The patches are cut into flat pieces with a certified distance
-(:func:`implicitvox.mesh.bezier.bezier_triangles`), and the pieces, grown by
-that distance, voxelized exactly (:mod:`implicitvox.mesh.pairs`).
+(:func:`implicitvox.triangles.bezier.bezier_triangles`), and the pieces, grown by
+that distance, voxelized exactly (:mod:`implicitvox.triangles.pairs`).
 
 Examples
 --------
@@ -19,14 +19,14 @@ from typing import Any, Callable, Iterable, Optional, Union
 import numpy as np
 
 from .. import validate
-from ..mesh.bezier import BezierPatch, bezier_triangles
-from ..mesh.pairs import surface_codes
-from ..mesh.tribox import Triangles
+from ..triangles.bezier import BezierPatch, bezier_triangles
+from ..triangles.pairs import surface_codes
+from ..triangles.tribox import Triangles
 from ..octree.grid import Grid
 from ..octree.store import Octree
 from ..octree.voxels import Voxels
-from .implicit import grid_of
-from .memory import memory_budget, refuse_over_budget
+from ..octree.grid import grid_of
+from ..octree.budget import memory_budget, refuse_over_budget
 from .mesh import estimate_mesh_memory, nearest_triangle_normals
 
 __all__ = ["voxelize_bezier", "BezierSource"]

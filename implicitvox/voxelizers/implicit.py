@@ -24,12 +24,12 @@ from ..eval.function import Function
 from ..eval.gradient import evaluate_gradients
 from ..expr.shape import as_shape, exact_classifier, voxel_classifier
 from ..octree import morton
-from ..octree.grid import Grid, padded_bounds
+from ..octree.grid import Grid, grid_of, padded_bounds
 from ..octree.guard import MemoryGuard
 from ..octree.store import Octree
 from ..octree.subdivide import RECHECK, subdivide
 from ..octree.voxels import Voxels
-from .memory import memory_budget, refuse_over_budget
+from ..octree.budget import memory_budget, refuse_over_budget
 
 __all__ = ["voxelize", "estimate_memory", "bytes_per_voxel", "grid_of", "ImplicitSource",
            "voxel_normals"]
@@ -45,24 +45,6 @@ _BYTES_PER_BOX = 512
 USELESS_SHARE = 0.5
 USELESS_MIN_CELLS = 4096
 _NORMALS_CHUNK = batches.NORMALS
-
-
-def grid_of(shape_bounds: Any, bounds: Any, resolution: Any, voxel_size: Any,
-            what: str = "the shape") -> Grid:
-    """The grid of a run: over ``bounds``, or over the shape's own bounds padded
-    by the one rule (:func:`implicitvox.octree.grid.padded_bounds`); cubic
-    voxels unless ``resolution`` or ``voxel_size`` is given per axis.
-    ``resolution`` defaults to 256 when neither is given."""
-    if resolution is None and voxel_size is None:
-        resolution = 256
-    if resolution is not None and voxel_size is not None:
-        raise ValueError("give resolution or voxel_size, not both")
-    if bounds is None:
-        if shape_bounds is None:
-            raise ValueError(f"bounds is required: {what} has no bounds of its own; pass "
-                             "bounds=((x0, y0, z0), (x1, y1, z1))")
-        bounds = padded_bounds(shape_bounds, resolution, voxel_size)
-    return Grid.from_bounds(bounds, resolution, voxel_size)
 
 
 def estimate_memory(func: Function, grid: Grid, normals: bool = False, prune: bool = True

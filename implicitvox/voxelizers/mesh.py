@@ -1,10 +1,10 @@
 """``voxelize_mesh``: exactly the voxels a triangle mesh meets (Stolte §6, Varadhan §3.3).
 
 A voxel is output iff its closed box meets a closed triangle of the mesh,
-decided by the exact box-triangle test of :mod:`implicitvox.mesh.tribox`
+decided by the exact box-triangle test of :mod:`implicitvox.triangles.tribox`
 during an octree subdivision with per-node triangle lists
-(:mod:`implicitvox.mesh.pairs`). ``interior=True`` adds the interior of
-closed meshes (:mod:`implicitvox.mesh.fill`).
+(:mod:`implicitvox.triangles.pairs`). ``interior=True`` adds the interior of
+closed meshes (:mod:`implicitvox.triangles.fill`).
 
 Examples
 --------
@@ -26,15 +26,15 @@ from typing import Any, Callable, Optional, Union
 import numpy as np
 
 from .. import validate
-from ..mesh.fill import BYTES_PER_VOXEL, interior_octants
-from ..mesh.inputs import as_triangles
-from ..mesh.pairs import surface_codes
-from ..mesh.tribox import Triangles
+from ..triangles.fill import BYTES_PER_VOXEL, interior_octants
+from ..triangles.inputs import as_triangles
+from ..triangles.pairs import surface_codes
+from ..triangles.tribox import Triangles
 from ..octree.grid import Grid
 from ..octree.store import Octree
 from ..octree.voxels import Voxels
-from .implicit import grid_of
-from .memory import memory_budget, refuse_over_budget
+from ..octree.grid import grid_of
+from ..octree.budget import memory_budget, refuse_over_budget
 
 __all__ = ["voxelize_mesh", "mesh_bounds", "MeshSource", "nearest_triangle_normals"]
 
@@ -116,7 +116,7 @@ def voxelize_mesh(mesh: Any, resolution: Union[int, tuple[int, int, int], None] 
         The voxels' edge length instead of ``resolution``.
     interior : bool, default: False
         Also store the voxels inside the mesh (as octants; see
-        :mod:`implicitvox.mesh.fill`, which says what open meshes get).
+        :mod:`implicitvox.triangles.fill`, which says what open meshes get).
     progress : callable, optional
         Called with the share of the work done (0 to 1).
     max_memory : int, optional

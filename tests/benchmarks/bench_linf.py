@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from implicitvox import linf
-from implicitvox.mesh.inputs import as_triangles
+from implicitvox.triangles.inputs import as_triangles
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2]))     # the repository root
 from tests.support.mesh_helpers import BUNNY  # noqa: E402

@@ -23,7 +23,7 @@ from pathlib import Path
 import numpy as np
 
 import implicitvox as ivx
-from implicitvox.mesh.inputs import as_triangles
+from implicitvox.triangles.inputs import as_triangles
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2]))     # the repository root
 from tests.support.mesh_helpers import BUNNY, sample_surface  # noqa: E402

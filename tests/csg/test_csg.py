@@ -56,8 +56,8 @@ def test_interior_and_surface_bracket_the_volume(name, solid, volume):
     inner = vox.interior_count * cell
     outer = (vox.interior_count + vox.count) * cell
     if volume is None:       # polyhedron minus a cylinder: Monte Carlo with exact winding
-        from implicitvox.mesh.crossings import RayWinding
-        from implicitvox.mesh.inputs import as_triangles
+        from implicitvox.triangles.crossings import RayWinding
+        from implicitvox.triangles.inputs import as_triangles
         v, f = as_triangles(SPHERE_MESH.scale((1, 1, 2), inplace=False))
         rng = np.random.default_rng(0)
         (lo, hi), n = solid.bounds, 400_000

@@ -17,7 +17,7 @@ from csg import read_openscad
 from csg.facets import fragments
 from csg.openscad import SUPPORTED
 from csg.openscad_parser import OpenSCADError, parse
-from implicitvox.mesh.inputs import as_triangles
+from implicitvox.triangles.inputs import as_triangles
 from tests.support.clip_oracle import triangle_meets_box
 from tests.support.mesh_helpers import sample_surface
 

@@ -113,7 +113,7 @@ def test_mesh_matches_brute_force():
     """10^4 points around PyVista's nut against the least distance over all its triangles
     (no hierarchy, no culling)."""
     import pyvista as pv
-    from implicitvox.mesh.inputs import as_triangles
+    from implicitvox.triangles.inputs import as_triangles
     v, f = as_triangles(pv.examples.load_nut())
     mesh = linf.TriangleMesh(v, f)
     rng = np.random.default_rng(3)
@@ -186,7 +186,7 @@ def test_public_entry_point_and_errors():
 
 def test_voxelizing_a_rotated_box_gives_exactly_the_voxels_it_meets():
     """Oracle: the exact box-triangle test against the box's 12 faces (another algorithm)."""
-    from implicitvox.mesh.tribox import Triangles
+    from implicitvox.triangles.tribox import Triangles
     rng = np.random.default_rng(5)
     corners = (CUBE - 0.5) * [1.3, 0.9, 0.6] @ _rotation(rng).T + 0.05
     poly = linf.ConvexPolyhedron.from_points(corners)

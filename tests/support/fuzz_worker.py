@@ -17,7 +17,7 @@ os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
 
 import implicitvox as ivx  # noqa: E402
 from csg import load_json, read_openscad  # noqa: E402
-from implicitvox.mesh.inputs import as_triangles  # noqa: E402
+from implicitvox.triangles.inputs import as_triangles  # noqa: E402
 
 DOCUMENTED = (ValueError, FileNotFoundError, MemoryError)
 

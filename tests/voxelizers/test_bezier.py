@@ -6,7 +6,7 @@ import pytest
 
 import implicitvox as ivx
 from implicitvox.octree import morton
-from implicitvox.mesh.bezier import bezier_triangles
+from implicitvox.triangles.bezier import bezier_triangles
 from tests.support.mesh_helpers import misses
 
 
@@ -48,7 +48,7 @@ def test_far_from_the_origin():
 def test_covering_triangles_hold_the_patch():
     """Every sampled patch point lies within the dilation of some covering triangle:
     the box of half-widths ``dilation`` around the point meets the triangle."""
-    from implicitvox.mesh.tribox import Triangles
+    from implicitvox.triangles.tribox import Triangles
     rng = np.random.default_rng(4)
     patch = ivx.BezierPatch(rng.normal(size=(4, 4, 3)))
     tri, dil = bezier_triangles([patch], np.full(3, 0.05))

@@ -50,7 +50,7 @@ def test_the_default_budget_respects_the_address_space_limit():
     code = textwrap.dedent("""
         import resource
         resource.setrlimit(resource.RLIMIT_AS, (3 << 30, resource.RLIM_INFINITY))
-        from implicitvox.voxelizers.memory import available_memory, memory_budget
+        from implicitvox.octree.budget import available_memory, memory_budget
         print(available_memory() <= 3 << 30, memory_budget(None) <= 3 << 29)
         """)
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)

@@ -8,7 +8,7 @@ import pytest
 import pyvista as pv
 
 import implicitvox as ivx
-from implicitvox.mesh.inputs import as_triangles
+from implicitvox.triangles.inputs import as_triangles
 from tests.support.mesh_helpers import (BUNNY, misses, neighbours_outside, oracle_meets,
                                 sample_surface)
 

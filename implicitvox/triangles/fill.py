@@ -4,7 +4,7 @@ Voxels the surface does not meet fall into 6-connected components
 (:func:`scipy.ndimage.label`); two face-neighbours that both miss the surface
 are on the same side of it, so each component is wholly inside or wholly
 outside a closed mesh. The generalized winding number
-(:mod:`implicitvox.mesh.winding`) at a few voxel centres of each component says
+(:mod:`implicitvox.triangles.winding`) at a few voxel centres of each component says
 which: inside iff it exceeds 1/2. Only a handful of points per component are
 evaluated, never one per voxel.
 

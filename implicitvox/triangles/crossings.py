@@ -4,7 +4,7 @@ For a point ``p`` off the surface, the winding number of a closed, oriented
 mesh is the signed count of the triangles the ray ``p + t e_x`` (``t > 0``)
 crosses: ``+1`` where it leaves through a triangle facing ``+x``, ``-1``
 where it enters. Each test is a sign of exact predicates
-(:mod:`implicitvox.mesh.predicates`):
+(:mod:`implicitvox.triangles.predicates`):
 
 * the ray meets the triangle's shadow on the ``yz`` plane: three ``orient2d``
   signs equal to the shadow's orientation. Rays through a shadow's edge or
@@ -16,13 +16,13 @@ where it enters. Each test is a sign of exact predicates
 Only the triangles whose shadow's box holds ``(p_y, p_z)`` are tested (a
 uniform grid on the ``yz`` plane), so a query costs a few tests, not one per
 triangle. For open meshes use the generalized winding number
-(:mod:`implicitvox.mesh.winding`) instead.
+(:mod:`implicitvox.triangles.winding`) instead.
 
 Examples
 --------
 >>> import numpy as np
 >>> import pyvista as pv
->>> from implicitvox.mesh.inputs import as_triangles
+>>> from implicitvox.triangles.inputs import as_triangles
 >>> v, f = as_triangles(pv.Cube())
 >>> RayWinding(v[f])(np.array([[0.0, 0.0, 0.0], [-0.2, 0.3, 0.3], [2.0, 0.0, 0.0]])).tolist()
 [1, 1, 0]

@@ -12,7 +12,7 @@ Examples
 --------
 >>> import numpy as np
 >>> import pyvista as pv
->>> from implicitvox.mesh.inputs import as_triangles
+>>> from implicitvox.triangles.inputs import as_triangles
 >>> v, f = as_triangles(pv.Cube())
 >>> np.round(winding_numbers(np.array([[0.0, 0, 0], [2.0, 0, 0]]), v[f]), 6).tolist()
 [1.0, 0.0]

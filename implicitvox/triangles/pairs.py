@@ -9,7 +9,7 @@ level in chunks of bounded size:
    (exact float comparisons against the children's edges);
 2. a child whose box holds the triangle's whole bounding box meets it (no
    test needed); the others go through the exact box-triangle test of
-   :mod:`implicitvox.mesh.tribox`;
+   :mod:`implicitvox.triangles.tribox`;
 3. at the voxel level, the voxels met by any pair are the output.
 
 Both filters are exact, so the result is exactly the set of voxels whose
@@ -21,7 +21,7 @@ Examples
 --------
 >>> import numpy as np
 >>> from implicitvox.octree.grid import Grid
->>> from implicitvox.mesh.tribox import Triangles
+>>> from implicitvox.triangles.tribox import Triangles
 >>> tri = Triangles(np.array([[[0.1, 0.1, 0.5], [0.9, 0.1, 0.5], [0.1, 0.9, 0.5]]]))
 >>> codes = surface_codes(tri, Grid.from_bounds(((0, 0, 0), (1, 1, 1)), 4))
 >>> len(codes)   # z = 0.5 is the edge between voxel layers 1 and 2: 13 voxels in each

@@ -20,7 +20,7 @@ condition is flatness instead of size:
 So the exact patch lies within ``D = deviation + twist / 4 + E`` (widened for
 the rounding of these sums) of the two triangles. A sub-patch stops when
 ``D <= flatness * voxel_size`` on every axis; its triangles, each grown by
-``D``, are voxelized exactly (:class:`~implicitvox.mesh.tribox.Triangles` with a
+``D``, are voxelized exactly (:class:`~implicitvox.triangles.tribox.Triangles` with a
 dilation; :func:`implicitvox.voxelize_bezier`). Every voxel the patch meets is output - a guarantee, not an
 estimate - and large flat regions stop early as large triangles.
 

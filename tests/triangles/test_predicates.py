@@ -8,7 +8,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from implicitvox.mesh.predicates import det2_sign, exact_integers, orient3d_sign
+from implicitvox.triangles.predicates import det2_sign, exact_integers, orient3d_sign
 
 
 def _sign(v: Fraction) -> int:

@@ -4,7 +4,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from implicitvox.mesh.tribox import Triangles
+from implicitvox.triangles.tribox import Triangles
 from tests.support.clip_oracle import triangle_meets_box
 
 

@@ -6,7 +6,7 @@ the memory available now.
 
 Examples
 --------
->>> from implicitvox.voxelizers.memory import memory_budget
+>>> from implicitvox.octree.budget import memory_budget
 >>> memory_budget(2**30)
 1073741824
 >>> memory_budget(None) > 0

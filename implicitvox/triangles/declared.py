@@ -121,4 +121,4 @@ def _check_vtp(path: str, data) -> None:
         if count > MAX_ELEMENTS:
             raise _refuse(path, f"it declares NumberOf{m.group(1).decode()} = {count:,}, over "
                                 f"the limit of {MAX_ELEMENTS:,} "
-                                "(implicitvox.mesh.declared.MAX_ELEMENTS)")
+                                "(implicitvox.triangles.declared.MAX_ELEMENTS)")

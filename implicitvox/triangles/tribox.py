@@ -7,7 +7,7 @@ a box axis with a triangle edge. They are disjoint iff one axis separates
 their projections. Each comparison is rewritten as the sign of a determinant
 of the input floats - no axis vector, projection or translation is ever
 rounded - and evaluated with the exact predicates of
-:mod:`implicitvox.mesh.predicates`:
+:mod:`implicitvox.triangles.predicates`:
 
 * box normals: ``tri_min > box_hi`` or ``tri_max < box_lo`` (float compares,
   exact);
@@ -55,7 +55,7 @@ class Triangles:
     A triangle with a ``dilation`` ``d`` (per axis) stands for the set of
     points within ``d`` of it in the weighted max-norm: a box meets it iff the
     box grown by ``d`` (rounded outward) meets the triangle. That is how
-    :mod:`implicitvox.mesh.bezier` covers a curved patch with two flat triangles.
+    :mod:`implicitvox.triangles.bezier` covers a curved patch with two flat triangles.
 
     Attributes
     ----------

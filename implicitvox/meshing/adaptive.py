@@ -1,0 +1,327 @@
+"""The adaptive grid without complex cells (Varadhan et al. §5.2).
+
+A cell is *complex* when the surface meets it but no edge of it shows a sign
+change. Contouring cannot see such a surface: marching cubes or dual
+contouring put nothing there, and where a coarse complex cell meets finer
+cells that do see the surface, the mesh cracks (Varadhan Fig. 8). The grid
+is therefore built as in §5.2:
+
+1. the cells the surface may meet are found by the voxelizer
+   (:func:`implicitvox.octree.subdivide.subdivide`: interval arithmetic,
+   Stolte §2, and the shape's exact test where it has one, Varadhan §5.1)
+   down to the *tolerance level*, whose cells are no larger than the
+   tolerance allows;
+2. below it, a cell the surface may meet is kept as a leaf when it is
+   *simple*: some edge shows a sign change, and the interval gradient over
+   the cell says the surface in it is one monotone sheet (every component of
+   the gradient has one sign, or one component is bounded away from 0, so
+   each line along that axis meets the surface once);
+3. a cell whose corners all have one sign, and whose gradient components all
+   have one sign, holds no surface point: ``f`` is monotone along every axis
+   over it, so its extremes are at corners, and the corners' enclosures
+   (outward rounded) exclude 0. It is dropped;
+4. every other cell is subdivided, down to ``refine`` levels below the
+   tolerance level; the cells still complex there are *uncertified* and
+   counted (see below).
+
+What this gives (the argument of §5.2, with this implementation's
+rounding). Every point ``p`` of the surface lies in a leaf: cells are only
+dropped on an outward-rounded enclosure or an exact test that excludes the
+surface. A leaf with a sign change gets a contour vertex inside it
+(:mod:`implicitvox.meshing.contour`), so ``p`` is within the leaf's size
+``s`` of the mesh in the max norm (``s·√3`` Euclidean). Every mesh triangle
+joins vertices of the cells around one edge that holds a zero of ``f`` (its
+ends have opposite signs), so every mesh point is within the largest of
+those cells' sizes of that zero. With every leaf no larger than ``h``, the
+two-sided Hausdorff distance is at most ``h`` in the max norm and ``h·√3``
+Euclidean. The exceptions are the uncertified cells (a surface detail
+smaller than a cell ``2**refine`` times smaller than ``h``, or a tangency):
+they are reported, never hidden. Signs at corners are those of the float64
+point values, computed by one formula per lattice point, so neighbours agree.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any, Callable, Optional
+
+import numpy as np
+
+from ..eval.function import Function
+from ..interval import rounding as R
+from ..eval.interval import evaluate_intervals
+from ..eval.mean_value import evaluate_interval_gradients
+from ..eval.point import evaluate_points
+from ..octree.grid import Grid
+from ..octree.guard import MemoryGuard
+from ..octree import morton
+from ..octree.morton import CORNERS
+from ..octree.subdivide import classify, subdivide
+from ..expr.shape import AMBIGUOUS
+
+__all__ = ["AdaptiveGrid", "adaptive_grid", "corner_values", "BYTES_PER_CELL"]
+
+#: bytes per leaf cell: coordinates, level, 8 corner values, flags, and the
+#: contouring's edges, crossings and quadric sums
+BYTES_PER_CELL = 640
+#: cells classified per numpy call below the tolerance level
+_CHUNK = 1 << 14
+_DEBUG = False
+#: a gradient component counts as one-signed when its other side is within this
+#: share of the largest component (an exact 0 rounded outward)
+_FLAT = 1e-9
+
+
+@dataclass
+class AdaptiveGrid:
+    """The leaves of an adaptive grid (see the module docstring).
+
+    Attributes
+    ----------
+    grid : Grid
+        The finest grid: its voxels are the cells ``refine`` levels below the
+        tolerance level, and ``grid.depth`` is that level.
+    tolerance_level : int
+        The level of the cells no larger than the tolerance allows; leaves are
+        at this level or deeper.
+    levels : ndarray of int8, (n,)
+        Each leaf's level.
+    coords : ndarray of int64, (n, 3)
+        Each leaf's integer coordinates at its level.
+    corners : ndarray of float64, (n, 8)
+        ``f`` at the leaf's corners (corner ``c`` at offset
+        ``(c & 1, c >> 1 & 1, c >> 2 & 1)``).
+    simple : ndarray of bool, (n,)
+        Sign change and one monotone sheet (the leaves above the finest level
+        all are).
+    complex : ndarray of bool, (n,)
+        Leaves at the finest level that the surface may meet but whose corners
+        show no sign change: they get no vertex, and the Hausdorff bound covers
+        them only where a neighbour's vertex is near enough
+        (:func:`implicitvox.meshing.contour.dual_contour` checks).
+    cells_evaluated : int
+        Cells classified below the tolerance level.
+    """
+
+    grid: Grid
+    tolerance_level: int
+    levels: np.ndarray
+    coords: np.ndarray
+    corners: np.ndarray
+    simple: np.ndarray
+    complex: np.ndarray
+    cells_evaluated: int
+
+    @property
+    def count(self) -> int:
+        """The number of leaves."""
+        return len(self.levels)
+
+    def sizes(self) -> np.ndarray:
+        """Each leaf's edge length in world units (the longest axis for
+        non-cubic cells)."""
+        h = max(self.grid.voxel_size)
+        return h * np.exp2(self.grid.depth - self.levels.astype(np.float64))
+
+
+def corner_values(func: Function, grid: Grid, level: int, coords: np.ndarray) -> np.ndarray:
+    """``f`` (float64) at the 8 corners of cells ``coords`` at ``level`` of
+    ``grid``; each lattice point's position comes from :meth:`Grid.edge`, so
+    every cell sharing a corner sees the same value."""
+    scale = 1 << (grid.depth - level)
+    idx = (coords[:, None, :].astype(np.int64) + CORNERS[None]) * scale     # (n, 8, 3)
+    pos = [grid.edge(a, np.minimum(idx[..., a], grid.shape[a])) for a in range(3)]
+    with np.errstate(all="ignore"):
+        values = evaluate_points(func.tape, pos[0].ravel(), pos[1].ravel(), pos[2].ravel())
+    return np.broadcast_to(values, (idx.shape[0] * 8,)).reshape(-1, 8).astype(np.float64)
+
+
+def _monotone(func: Function, grid: Grid, level: int, coords: np.ndarray
+              ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``(weak, strict, leak)`` from the interval gradient over each cell.
+
+    ``weak``: every component has one sign (up to ``_FLAT`` of the largest, the
+    outward rounding of an exact 0); ``strict``: some component is bounded away
+    from 0; ``leak``: an upper bound of how far ``f`` inside the cell can
+    pass the range of its corner values. For each axis, moving from a point
+    to the face on the mostly-downhill side changes ``f`` by at most the
+    smaller one-sided slope times the width (the mean value theorem), so
+    ``min(corners) - leak <= f <= max(corners) + leak`` over the cell;
+    infinite where the mean value theorem may fail (domain edges, jumps)."""
+    lo, hi = grid.octant_boxes(level, coords)
+    with np.errstate(all="ignore"):
+        _, _, glo, ghi, valid = evaluate_interval_gradients(func.tape, lo, hi)
+        glo, ghi = np.asarray(glo, dtype=np.float64), np.asarray(ghi, dtype=np.float64)
+        valid = np.asarray(valid) & np.isfinite(glo).all(0) & np.isfinite(ghi).all(0)
+        one_sided = np.minimum(np.maximum(ghi, 0.0), np.maximum(-glo, 0.0))       # (3, n)
+        width = np.stack([h - l for l, h in zip(lo, hi)])
+        leak = R.up_nonneg((one_sided * width).sum(0) * (1 + 1e-12))
+        scale = np.maximum(np.abs(glo), np.abs(ghi)).max(0)
+    leak = np.where(valid, leak, np.inf)
+    weak = valid & (one_sided <= _FLAT * scale).all(0)
+    strict = valid & ((glo > 0) | (ghi < 0)).any(0)
+    return weak, strict, leak
+
+
+def _corners_exclude(func: Function, grid: Grid, level: int, coords: np.ndarray,
+                     leak: np.ndarray) -> np.ndarray:
+    """True where the outward-rounded enclosures of ``f`` at all 8 corners lie
+    beyond ``leak`` on one side of 0: then ``f`` has that sign on the whole cell."""
+    scale = 1 << (grid.depth - level)
+    idx = (coords[:, None, :].astype(np.int64) + CORNERS[None]) * scale
+    pos = tuple(grid.edge(a, np.minimum(idx[..., a], grid.shape[a])).ravel() for a in range(3))
+    with np.errstate(all="ignore"):
+        flo, fhi = evaluate_intervals(func.tape, pos, pos)
+        flo, fhi = flo.reshape(-1, 8), fhi.reshape(-1, 8)
+        return (R.down(flo.min(1) - leak) > 0) | (R.up(fhi.max(1) + leak) < 0)
+
+
+def _children(grid: Grid, level: int, coords: np.ndarray, owner: Optional[np.ndarray] = None
+              ) -> Any:
+    """The children of cells at ``level``, cropped to the grid (and the
+    ``owner`` of each, repeated from its parent's, when given)."""
+    kids = (coords[:, None, :] * 2 + CORNERS[None]).reshape(-1, 3)
+    scale = 1 << (grid.depth - level - 1)
+    inside = (kids * scale < np.asarray(grid.shape)).all(1)
+    if owner is None:
+        return kids[inside]
+    return kids[inside], np.repeat(owner, 8)[inside]
+
+
+def _may_hold_surface(func: Function, grid: Grid, level: int, cells: np.ndarray,
+                      exact: Optional[Callable]) -> np.ndarray:
+    """For cells without a sign change that no certificate empties: search their
+    subtrees down to ``grid.depth``. A cell is empty when every descendant is
+    rejected (interval or exact test, or corners beyond the leak); it may hold
+    surface when a descendant shows a sign change or stays undecided at the
+    finest level. Most such cells lie just beside the surface and empty in a
+    level or two; only the others need splitting."""
+    hold = np.zeros(len(cells), dtype=bool)
+    owner = np.arange(len(cells))
+    current = cells
+    while len(current) and level < grid.depth:
+        current, owner = _children(grid, level, current, owner)
+        level += 1
+        states = classify(func, grid, level, current, exact, mean_value=True)
+        current, owner = current[states == AMBIGUOUS], owner[states == AMBIGUOUS]
+        if not len(current):
+            break
+        inside = corner_values(func, grid, level, current) < 0
+        change = inside.any(1) & ~inside.all(1)
+        hold[owner[change]] = True
+        _, _, leak = _monotone(func, grid, level, current)
+        rest = ~change & ~hold[owner]
+        rest[rest] = ~_corners_exclude(func, grid, level, current[rest], leak[rest])
+        current, owner = current[rest], owner[rest]
+    hold[owner] = True
+    return hold
+
+
+#: the 26 neighbours' offsets
+_NEIGHBOURS = np.array([(i, j, k) for i in (-1, 0, 1) for j in (-1, 0, 1) for k in (-1, 0, 1)
+                        if (i, j, k) != (0, 0, 0)], dtype=np.int64)
+
+
+def _beside(cells: np.ndarray, split: np.ndarray) -> np.ndarray:
+    """Cells that are, or touch (faces, edges or corners), a cell marked ``split``.
+
+    The cells split for showing no sign change are where the surface may poke
+    through a face between corners. Splitting their neighbours too keeps the
+    change of level a cell away, where the finer side's extra samples on a
+    shared face show no crossing that the coarser side misses, so the contour
+    stays manifold across it."""
+    if not split.any():
+        return split
+    codes = morton.encode(cells)
+    near = (cells[split][:, None, :] + _NEIGHBOURS[None]).reshape(-1, 3)
+    near = near[(near >= 0).all(1)]
+    return split | np.isin(codes, morton.encode(near))
+
+
+def adaptive_grid(func: Function, grid: Grid, refine: int, *,
+                  exact: Optional[Callable] = None, exact_voxels: Optional[Callable] = None,
+                  progress: Optional[Callable[[float], Any]] = None,
+                  guard: Optional[MemoryGuard] = None, prune: bool = True) -> AdaptiveGrid:
+    """Build the adaptive grid of the module docstring.
+
+    Parameters
+    ----------
+    func : Function
+        The compiled implicit function.
+    grid : Grid
+        The tolerance level's grid (its voxels are the largest leaves).
+    refine : int
+        Levels below ``grid`` that complex cells may be subdivided to.
+    exact, exact_voxels : callable, optional
+        The shape's exact box tests (:func:`implicitvox.expr.shape.exact_classifier`,
+        :func:`~implicitvox.expr.shape.voxel_classifier`).
+    progress : callable, optional
+        Called with the share of work done (0 to 1).
+    guard : MemoryGuard, optional
+        Asked with the cells kept after every level.
+    prune : bool, default: True
+        Prune the tapes of the voxelization down to the tolerance level.
+
+    Examples
+    --------
+    >>> import implicitvox as iv
+    >>> from implicitvox import x, y, z
+    >>> from implicitvox.octree.grid import Grid
+    >>> g = Grid.from_bounds(((-1.2,) * 3, (1.2,) * 3), 8)
+    >>> a = adaptive_grid(iv.compile(x * x + y * y + z * z - 1), g, refine=2)
+    >>> bool(a.simple.all()), int(a.complex.sum()), int(a.levels.min()) == g.depth
+    (True, 0, True)
+    """
+    top = grid.depth
+    fine = grid.finer(refine)
+    depth = top + refine
+    share = (lambda s: progress(s)) if progress is not None else (lambda s: None)
+    voxels = subdivide(func, grid, exact=exact, exact_voxels=exact_voxels, guard=guard,
+                       prune=prune, progress=(lambda s: share(0.6 * s)))
+    cells = voxels.surface.astype(np.int64)
+    kept_levels, kept_coords, kept_corners, kept_simple, kept_complex = [], [], [], [], []
+    evaluated = 0
+    total = 0
+    for level in range(top, depth + 1):
+        if level > top and len(cells):
+            states = np.concatenate([
+                classify(func, fine, level, cells[s:s + _CHUNK], exact_voxels, mean_value=True)
+                for s in range(0, len(cells), _CHUNK)])
+            evaluated += len(cells)
+            cells = cells[states == AMBIGUOUS]
+        if not len(cells):
+            break
+        values = np.concatenate([corner_values(func, fine, level, cells[s:s + _CHUNK])
+                                 for s in range(0, len(cells), _CHUNK)])
+        inside = values < 0
+        change = inside.any(1) & ~inside.all(1)
+        weak, strict, leak = (np.concatenate(parts) for parts in zip(*(
+            _monotone(func, fine, level, cells[s:s + _CHUNK])
+            for s in range(0, len(cells), _CHUNK))))
+        simple = change & (weak | strict)
+        empty = np.zeros(len(cells), dtype=bool)
+        test = ~change & np.isfinite(leak)
+        if test.any():
+            empty[test] = _corners_exclude(func, fine, level, cells[test], leak[test])
+        test = ~change & ~empty
+        if test.any() and level < depth:
+            empty[test] = ~_may_hold_surface(func, fine, level, cells[test], exact_voxels)
+        leaf = simple | ((level == depth) & ~empty)
+        if _DEBUG:
+            print(level, len(cells), "change", int(change.sum()), "weak", int(weak.sum()), "strict", int(strict.sum()), "simple", int(simple.sum()), "empty", int(empty.sum()), "nochange-notweak", int((~change & ~weak).sum()))
+        if level < depth:
+            leaf &= ~_beside(cells, ~leaf & ~empty & ~change)
+        kept_levels.append(np.full(int(leaf.sum()), level, dtype=np.int8))
+        kept_coords.append(cells[leaf])
+        kept_corners.append(values[leaf])
+        kept_simple.append(simple[leaf])
+        kept_complex.append(~change[leaf])
+        total += int(leaf.sum())
+        cells = _children(fine, level, cells[~leaf & ~empty]) if level < depth else cells[:0]
+        if guard is not None:
+            guard.check(voxels=total, octants=len(cells))
+        share(0.6 + 0.4 * (level - top + 1) / (refine + 1))
+    def join(parts, shape, dtype):
+        return np.concatenate(parts) if parts else np.zeros(shape, dtype=dtype)
+    return AdaptiveGrid(fine, top, join(kept_levels, (0,), np.int8),
+                        join(kept_coords, (0, 3), np.int64), join(kept_corners, (0, 8), np.float64),
+                        join(kept_simple, (0,), bool), join(kept_complex, (0,), bool), evaluated)

@@ -1,0 +1,66 @@
+"""Where the surface crosses cell edges: certified brackets and normals.
+
+An edge whose ends have opposite signs holds a zero of ``f`` (``f`` is
+continuous there: the adaptive grid keeps only cells whose enclosure is
+defined). The zero is isolated by bisection on the signs: each step halves
+the bracket and keeps the half whose ends still differ, so after ``steps``
+steps a zero lies in a bracket ``2**-steps`` of the edge long, whatever the
+function does between samples. A single linear interpolation of the two end
+values, the usual choice, can land anywhere on a curved or kinked edge. The
+crossing is the bracket's midpoint, and its normal the unit gradient there
+(Ju et al. 2002 use these as the Hermite data of dual contouring).
+
+Examples
+--------
+>>> import numpy as np, implicitvox as iv
+>>> from implicitvox import x, y, z
+>>> f = iv.compile(x * x + y * y + z * z - 1)
+>>> p, n = crossings(f, np.array([[0.0, 0, 0]]), np.array([[2.0, 0, 0]]))
+>>> bool(abs(p[0, 0] - 1) < 1e-9), n[0].round(6).tolist()
+(True, [1.0, 0.0, 0.0])
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from ..eval.function import Function
+from ..eval.gradient import evaluate_gradients
+from ..eval.point import evaluate_points
+
+__all__ = ["crossings", "STEPS"]
+
+#: bisection steps: the bracket is 2**-STEPS of the edge
+STEPS = 24
+
+
+def crossings(func: Function, a: np.ndarray, b: np.ndarray, steps: int = STEPS
+              ) -> tuple[np.ndarray, np.ndarray]:
+    """Crossing points ``(n, 3)`` and unit normals ``(n, 3)`` of edges ``a -> b``
+    whose ends have opposite signs (``f < 0`` at exactly one end).
+
+    The normal is zero where the gradient is zero or not finite."""
+    a = np.asarray(a, dtype=np.float64)
+    b = np.asarray(b, dtype=np.float64)
+    tape = func.tape
+    n = len(a)
+    if n == 0:
+        return np.zeros((0, 3)), np.zeros((0, 3))
+    with np.errstate(all="ignore"):
+        inside_a = np.broadcast_to(evaluate_points(tape, *a.T), (n,)) < 0
+        lo = np.zeros(n)
+        hi = np.ones(n)
+        d = b - a
+        for _ in range(steps):
+            mid = 0.5 * (lo + hi)
+            p = a + mid[:, None] * d
+            inside = np.broadcast_to(evaluate_points(tape, *p.T), (n,)) < 0
+            same = inside == inside_a          # the zero is in the upper half
+            lo = np.where(same, mid, lo)
+            hi = np.where(same, hi, mid)
+        points = a + (0.5 * (lo + hi))[:, None] * d
+        _, g = evaluate_gradients(tape, *points.T)
+    g = np.broadcast_to(np.asarray(g, dtype=np.float64).reshape(3, -1), (3, n)).T
+    norm = np.linalg.norm(g, axis=1, keepdims=True)
+    with np.errstate(all="ignore"):
+        normals = np.where((norm > 0) & np.isfinite(norm), g / norm, 0.0)
+    return points, normals

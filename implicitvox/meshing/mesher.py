@@ -1,0 +1,172 @@
+"""``mesh``: a shape to triangles within a guaranteed Hausdorff distance.
+
+The adaptive grid without complex cells (Varadhan et al. §5.2,
+:mod:`implicitvox.meshing.adaptive`) contoured by dual contouring
+(:mod:`implicitvox.meshing.contour`). The two-sided Hausdorff distance
+between the mesh and the true surface is at most the tolerance (Euclidean),
+except in the uncertified cells, which the result counts and a warning names.
+
+Examples
+--------
+>>> import implicitvox as iv
+>>> from implicitvox import x, y, z, sqrt
+>>> m = iv.mesh(sqrt(x**2 + y**2 + z**2) - 1, tolerance=0.05, bounds=((-1.2,) * 3, (1.2,) * 3))
+>>> m.n_cells > 1000, float(m.field_data["hausdorff_bound"][0]) <= 0.05
+(True, True)
+"""
+from __future__ import annotations
+
+import math
+import time
+import warnings
+from typing import Any, Callable, Optional, Union
+
+import numpy as np
+
+from .. import validate
+from ..eval.function import Function
+from ..expr.shape import as_shape, exact_classifier, voxel_classifier
+from ..octree.budget import memory_budget, refuse_over_budget
+from ..octree.grid import Grid, grid_of
+from ..octree.guard import MemoryGuard
+from ..octree.morton import MAX_BITS
+from ..octree.subdivide import subdivide
+from ..version import __version__
+from .adaptive import BYTES_PER_CELL, adaptive_grid
+from .contour import dual_contour
+from .manifold import split_nonmanifold
+
+__all__ = ["mesh", "mesh_grid", "REFINE"]
+
+#: levels below the tolerance's cells that complex cells may be split to
+REFINE = 4
+#: the pilot voxelization's depth for the memory estimate
+_PILOT_DEPTH = 6
+#: leaves per surface voxel of the tolerance level, for the estimate (refined
+#: complex cells and the contouring's arrays)
+_LEAVES_PER_VOXEL = 2
+
+
+def mesh(shape: Any, tolerance: Optional[float] = None,
+         resolution: Union[int, tuple[int, int, int], None] = None, *, bounds: Any = None,
+         refine: int = REFINE, progress: Optional[Callable[[float], Any]] = None,
+         max_memory: Optional[int] = None, prune: bool = True) -> Any:
+    """Triangulate a shape's surface within a guaranteed Hausdorff distance.
+
+    Parameters
+    ----------
+    shape : Expr or Shape
+        The implicit function ``f`` (solid ``f <= 0``) or a shape object (csg
+        solids and OpenSCAD models included: their exact box tests are used).
+    tolerance : float, optional
+        The bound (world units, Euclidean) on the two-sided Hausdorff distance
+        between the mesh and the surface. The largest cells are cubes of edge
+        ``tolerance / √3``. Give this or ``resolution``.
+    resolution : int, optional
+        Cells along the longest side of the bounds at the coarsest leaf level
+        instead; the bound is then ``√3`` times the cell size.
+    bounds : ((x0, y0, z0), (x1, y1, z1)), optional
+        The grid's box; by default the shape's own bounds padded by half a
+        cell. The mesh is open where the surface leaves the bounds.
+    refine : int, default: 4
+        Levels below the largest cells that complex cells (the surface meets
+        them but no edge shows it: thin sheets, near contacts) are split to.
+    progress : callable, optional
+        Called with the share of work done (0 to 1).
+    max_memory : int, optional
+        Refuse (``MemoryError``) when the estimate exceeds this many bytes,
+        and stop when the run does; default half the available memory.
+    prune : bool, default: True
+        Prune the tapes while voxelizing (:func:`implicitvox.voxelize`).
+
+    Returns
+    -------
+    pyvista.PolyData
+        Triangles oriented outward (their normals point to ``f > 0``). Its
+        ``field_data`` holds ``hausdorff_bound`` (Euclidean, world units),
+        ``linf_bound`` (max norm), ``complex_cells`` (finest cells the surface
+        may meet that no edge shows), ``uncertified_cells`` (those of them with
+        a point farther than the bound from every vertex around them: the bound
+        does not cover them; 0 means it holds everywhere), ``open_edges``
+        (sign-change edges at the bounds, where the mesh is open),
+        ``non_manifold_edges`` (edges still in more than two triangles after
+        the vertex splitting of :mod:`implicitvox.meshing.manifold`), ``leaves``
+        and ``seconds``.
+
+    Raises
+    ------
+    ValueError
+        For bad options (the message names the parameter).
+    MemoryError
+        When the estimate, or the run, exceeds ``max_memory``.
+    """
+    shape = as_shape(shape)
+    if (tolerance is None) == (resolution is None):
+        raise ValueError("give one of tolerance (the Hausdorff bound, world units) or "
+                         "resolution (cells along the longest side)")
+    voxel_size = None
+    if tolerance is not None:
+        tol = validate.positive_number(tolerance, "tolerance")
+        voxel_size = tol / math.sqrt(3) * (1 - 2.0 ** -40)
+    refine = validate.int_in(refine, "refine", 0, 12)
+    grid = grid_of(getattr(shape, "bounds", None), bounds, resolution, voxel_size)
+    if grid.depth + refine > MAX_BITS:
+        raise ValueError(f"the grid {grid.shape} with refine={refine} needs "
+                         f"{grid.depth + refine} octree levels, over the {MAX_BITS} there are; "
+                         "raise tolerance or lower refine")
+    return mesh_grid(shape, grid, refine=refine, progress=progress,
+                     budget=memory_budget(max_memory), prune=validate.boolean(prune, "prune"))
+
+
+def mesh_grid(shape: Any, grid: Grid, *, refine: int = REFINE,
+              progress: Optional[Callable[[float], Any]] = None, budget: int,
+              prune: bool = True) -> Any:
+    """:func:`mesh` on a given grid (its voxels are the largest cells), under a
+    byte ``budget``; :meth:`implicitvox.Voxels.to_mesh` uses it."""
+    import pyvista as pv
+
+    shape = as_shape(shape)
+    func = Function(shape.expr)
+    exact, exact_voxels = exact_classifier(shape), voxel_classifier(shape)
+    estimated = _estimate_leaves(func, grid, exact, prune)
+    what = f"meshing at {grid.shape}"
+    refuse_over_budget(estimated * BYTES_PER_CELL, budget, f"{what} (~{estimated:,} cells)")
+    guard = MemoryGuard(budget, what, BYTES_PER_CELL, estimated_voxels=estimated)
+    t0 = time.perf_counter()
+    share = progress if progress is not None else (lambda s: None)
+    agrid = adaptive_grid(func, grid, refine, exact=exact, exact_voxels=exact_voxels,
+                          progress=lambda s: share(0.8 * s), guard=guard, prune=prune)
+    h = max(grid.voxel_size)
+    contour = dual_contour(func, agrid, bound=h * math.sqrt(3))
+    share(1.0)
+    points, triangles, non_manifold = split_nonmanifold(contour.points, contour.faces)
+    faces = np.hstack([np.full((len(triangles), 1), 3, dtype=np.int64), triangles])
+    out = pv.PolyData(points, faces=faces.ravel()) if len(triangles) else pv.PolyData()
+    out.field_data["hausdorff_bound"] = [h * math.sqrt(3)]
+    out.field_data["linf_bound"] = [h]
+    out.field_data["uncertified_cells"] = [contour.uncovered]
+    out.field_data["complex_cells"] = [int(agrid.complex.sum())]
+    out.field_data["open_edges"] = [contour.unmatched]
+    out.field_data["non_manifold_edges"] = [non_manifold]
+    out.field_data["leaves"] = [agrid.count]
+    out.field_data["seconds"] = [time.perf_counter() - t0]
+    out.field_data["implicitvox"] = [__version__]
+    if contour.uncovered:
+        warnings.warn(f"{contour.uncovered:,} cells of size {h / 2 ** refine:.3g} may hold "
+                      "surface that no cell edge shows (detail below the finest cell, or a "
+                      "tangency): the Hausdorff bound does not cover them; raise refine or "
+                      "lower tolerance", UserWarning, stacklevel=3)
+    return out
+
+
+def _estimate_leaves(func: Function, grid: Grid, exact, prune: bool) -> int:
+    """Leaves of the adaptive grid, estimated from a pilot voxelization at depth
+    ``min(depth, 6)`` grown by Stolte's factor of 4 per level (§4.1.3)."""
+    depth = grid.depth
+    pilot_depth = min(depth, _PILOT_DEPTH)
+    scale = 1 << (depth - pilot_depth)
+    pilot = Grid(grid.origin, tuple(h * scale for h in grid.voxel_size),
+                 tuple(-(-n // scale) for n in grid.shape))
+    found = len(subdivide(func, pilot, recheck=0.0, prune=prune, exact=exact).codes)
+    cells = float(np.prod(grid.shape, dtype=np.float64))
+    return int(min(found * 4.0 ** (depth - pilot_depth), cells) * _LEAVES_PER_VOXEL)
