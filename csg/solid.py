@@ -141,6 +141,20 @@ class Solid:
         or None when no leaf has an exact test; built once per solid."""
         return plan(self)
 
+    @property
+    def expression_is_exact(self) -> bool:
+        """Whether :attr:`expr` is the solid's own function (zero on its surface,
+        negative inside); False when a leaf's is only a bound (a polyhedron:
+        OpenSCAD's facets, imported meshes), whose geometry only the exact test
+        knows. :func:`implicitvox.mesh` needs point values, so it needs this."""
+        stack = [self]
+        while stack:
+            node = stack.pop()
+            if node.needs_exact_test:
+                return False
+            stack.extend(node.children)
+        return True
+
     # -- voxelization --------------------------------------------------------------
     @property
     def classify_boxes(self) -> Optional[Callable[[np.ndarray, np.ndarray], np.ndarray]]:

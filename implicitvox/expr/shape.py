@@ -16,6 +16,11 @@ A shape has
   shapes whose ``classify_boxes`` may leave a box undecided (AMBIGUOUS) to
   save work on octants that will be subdivided anyway (:mod:`csg` booleans).
 
+* ``expression_is_exact`` (optional, default True) - False when ``expr``
+  only bounds the solid (zero inside a polyhedron's bounding box, say) and
+  the exact test alone knows the surface: such a shape can be voxelized,
+  not meshed (:func:`implicitvox.mesh` needs point values).
+
 A bare expression is a shape without bounds or exact test.
 """
 from __future__ import annotations
@@ -27,7 +32,7 @@ import numpy as np
 from .nodes import Expr
 
 __all__ = ["Shape", "EMPTY", "FULL", "AMBIGUOUS", "as_shape", "ExprShape", "exact_classifier",
-           "voxel_classifier"]
+           "voxel_classifier", "expression_is_exact"]
 
 #: octant states
 EMPTY, FULL, AMBIGUOUS = 0, 1, 2
@@ -72,3 +77,8 @@ def voxel_classifier(shape: Any) -> Optional[Callable[[np.ndarray, np.ndarray], 
     ``classify_boxes``), if it has one."""
     test = getattr(shape, "classify_voxels", None)
     return test if callable(test) else exact_classifier(shape)
+
+
+def expression_is_exact(shape: Any) -> bool:
+    """Whether the shape's ``expr`` is its own function (see the module docstring)."""
+    return bool(getattr(shape, "expression_is_exact", True))

@@ -7,12 +7,16 @@
     implicitvox voxelize model.py --resolution 512 --bounds -1 -1 -1 1 1 1 --out model.npz
     implicitvox voxelize bunny.obj --resolution 256 --interior --render bunny.png
     implicitvox voxelize bracket.csg --facets openscad --resolution 256 --out bracket.npz
+    implicitvox mesh --example gear --tolerance 0.01 --out gear.stl --render gear.png
 
 A model file is Python that defines ``shape`` (an expression or a shape);
 errors inside it are reported with the model's own file and line. OpenSCAD
 ``.csg`` files and JSON scenes are read by ``csg`` (registered as loaders). A mesh
 file (``.stl``, ``.ply``, ``.obj``, ``.vtk``, ``.vtp``) is voxelized exactly
 (:func:`implicitvox.voxelize_mesh`; ``--interior`` fills closed meshes).
+``mesh`` triangulates a model within a guaranteed Hausdorff distance
+(:func:`implicitvox.mesh`) and writes ``.stl``, ``.ply``, ``.obj``, ``.vtp`` or
+``.vtk``.
 """
 from __future__ import annotations
 
@@ -30,6 +34,9 @@ from ..triangles.inputs import MESH_SUFFIXES
 from ..octree.subdivide import RECHECK
 from ..voxelizers.implicit import voxelize
 from ..voxelizers.mesh import voxelize_mesh
+from ..meshing.mesher import REFINE, mesh
+from .files import MESH_FORMATS, save_mesh
+from .rendering import render_mesh
 
 __all__ = ["main", "ProgressBar", "load_model"]
 
@@ -150,28 +157,92 @@ def _parser() -> argparse.ArgumentParser:
     vox.add_argument("--render", metavar="PNG", help="render a picture")
     vox.add_argument("--max-memory", type=float, metavar="GIB", help="refuse runs estimated above")
     vox.add_argument("--quiet", action="store_true", help="no progress bar")
+    msh = sub.add_parser("mesh", help="triangulate a model within a guaranteed Hausdorff "
+                                      "distance")
+    msh.add_argument("model", nargs="?", help="a .py file that defines `shape`, or a .csg or "
+                                              ".json model")
+    msh.add_argument("--example", help="a built-in example instead of a model file")
+    size = msh.add_mutually_exclusive_group(required=True)
+    size.add_argument("--tolerance", type=float, metavar="E",
+                      help="the Hausdorff bound, world units (cells of edge E/sqrt(3))")
+    size.add_argument("--resolution", type=int,
+                      help="cells along the longest side (the bound is sqrt(3) cells)")
+    msh.add_argument("--bounds", type=float, nargs=6, metavar=("X0", "Y0", "Z0", "X1", "Y1", "Z1"))
+    msh.add_argument("--facets", choices=["true", "openscad"], default="true",
+                     help=".csg models: true curves, or OpenSCAD's own facets")
+    msh.add_argument("--refine", type=int, default=REFINE, metavar="K",
+                     help=f"levels complex cells may be split below the largest (default {REFINE})")
+    msh.add_argument("--no-prune", dest="prune", action="store_false",
+                     help="evaluate the whole expression everywhere (for comparison)")
+    msh.add_argument("--out", help=f"write {', '.join(MESH_FORMATS)}")
+    msh.add_argument("--render", metavar="PNG", help="render a picture (edges shown)")
+    msh.add_argument("--max-memory", type=float, metavar="GIB", help="refuse runs estimated above")
+    msh.add_argument("--quiet", action="store_true", help="no progress bar")
     return parser
 
 
-def _voxelize(args: argparse.Namespace) -> int:
+def _shape(args: argparse.Namespace) -> Any:
+    """The model of a command: a built-in example or a model file."""
     if (args.model is None) == (args.example is None):
         raise ModelError("give a model file or --example NAME (one of them)")
-    is_mesh = args.model is not None and args.model.lower().endswith(MESH_SUFFIXES)
-    shape = None
-    if not is_mesh:
-        shape = example(args.example) if args.example else \
-            load_model(args.model, **({"facets": args.facets} if not
-                                      args.model.endswith(".py") else {}))
+    if args.example:
+        return example(args.example)
+    options = {"facets": args.facets} if not args.model.endswith(".py") else {}
+    return load_model(args.model, **options)
+
+
+def _common(args: argparse.Namespace) -> tuple[Any, Any]:
+    """``(bounds, max_memory)`` of a command, checked; the output paths checked."""
     for path, flag in ((args.out, "--out"), (args.render, "--render")):
         if path is not None:
             validate.writable_path(path, flag)
     bounds = None
     if args.bounds:
         bounds = (tuple(args.bounds[:3]), tuple(args.bounds[3:]))
-    bar = None if args.quiet else ProgressBar()
     max_memory = None if args.max_memory is None else \
         validate.max_memory(validate.positive_number(args.max_memory, "--max-memory") * 2**30,
                              "--max-memory (bytes)")
+    return bounds, max_memory
+
+
+def _mesh(args: argparse.Namespace) -> int:
+    if args.model is not None and args.model.lower().endswith(MESH_SUFFIXES):
+        raise ModelError(f"{args.model} is already a triangle mesh; `mesh` triangulates "
+                         "implicit and csg models")
+    if args.out is not None and os.path.splitext(args.out)[1].lower() not in MESH_FORMATS:
+        raise ModelError(f"--out {args.out}: a mesh is written as one of "
+                         f"{', '.join(MESH_FORMATS)}")
+    shape = _shape(args)
+    bounds, max_memory = _common(args)
+    bar = None if args.quiet else ProgressBar("meshing")
+    result = mesh(shape, args.tolerance, args.resolution, bounds=bounds, refine=args.refine,
+                  progress=bar, max_memory=max_memory, prune=args.prune)
+    if bar:
+        bar.close()
+    data = result.field_data
+    print(f"{result.n_cells:,} triangles, {result.n_points:,} vertices in "
+          f"{float(data['seconds'][0]):.2f} s; Hausdorff distance <= "
+          f"{float(data['hausdorff_bound'][0]):.4g} (max norm {float(data['linf_bound'][0]):.4g})")
+    if int(data["uncertified_cells"][0]):
+        print(f"{int(data['uncertified_cells'][0]):,} cells are not covered by the bound "
+              "(raise --refine)")
+    if args.out:
+        print(f"wrote {save_mesh(result, args.out)}")
+    if args.render:
+        name = args.example or os.path.basename(args.model)
+        print(f"rendered {render_mesh(result, args.render, title=name)}")
+    return 0
+
+
+def _voxelize(args: argparse.Namespace) -> int:
+    is_mesh = args.model is not None and args.example is None and \
+        args.model.lower().endswith(MESH_SUFFIXES)
+    shape = None if is_mesh else _shape(args)
+    if args.out is not None and os.path.splitext(args.out)[1].lower() in MESH_FORMATS:
+        raise ModelError(f"--out {args.out}: voxels are not triangles; write a mesh with "
+                         "`implicitvox mesh MODEL --tolerance E --out X.stl`")
+    bounds, max_memory = _common(args)
+    bar = None if args.quiet else ProgressBar()
     if is_mesh:
         if args.normals or args.mean_value or args.subvoxel:
             raise ModelError("--normals, --mean-value and --subvoxel apply to implicit models, "
@@ -210,7 +281,7 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
             for name, (description, _) in EXAMPLES.items():
                 print(f"{name:<14}{description}")
             return 0
-        return _voxelize(args)
+        return _mesh(args) if args.command == "mesh" else _voxelize(args)
     except (ModelError, ValueError, TypeError, MemoryError, OSError) as err:
         if args.debug:
             traceback.print_exc()

@@ -27,9 +27,11 @@ from ..octree.grid import MAX_RESOLUTION, Grid
 from ..octree.store import Octree
 from ..octree.voxels import DEFAULT_DENSE_LIMIT, Voxels
 
-__all__ = ["save", "load", "FORMATS", "NPZ_LIMIT", "BINVOX_LIMIT"]
+__all__ = ["save", "load", "save_mesh", "FORMATS", "MESH_FORMATS", "NPZ_LIMIT", "BINVOX_LIMIT"]
 
 FORMATS = (".npz", ".vti", ".binvox")
+#: triangle mesh files :func:`save_mesh` writes (through PyVista's VTK writers)
+MESH_FORMATS = (".stl", ".ply", ".obj", ".vtp", ".vtk")
 _NPZ_VERSION = 1
 #: bytes an .npz may unpack to at most (checked before anything is read)
 NPZ_LIMIT = 16 << 30
@@ -40,6 +42,10 @@ _BINVOX_HEADER_LINES, _BINVOX_HEADER_LINE = 64, 4096
 
 def _suffix(path: str) -> str:
     ext = os.path.splitext(str(path))[1].lower()
+    if ext in MESH_FORMATS:
+        raise ValueError(f"{path!r} is a mesh file type, and voxels are not triangles: mesh the "
+                         "shape with `implicitvox mesh` (or implicitvox.mesh, Voxels.to_mesh); "
+                         f"voxel files are {FORMATS}")
     if ext not in FORMATS:
         raise ValueError(f"unknown voxel file type {ext!r} for {path!r}; use one of {FORMATS}")
     return ext
@@ -50,6 +56,31 @@ def save(vox: Voxels, path: str) -> str:
     ext = _suffix(path)
     validate.writable_path(path)
     {".npz": _save_npz, ".vti": _save_vti, ".binvox": _save_binvox}[ext](vox, str(path))
+    return str(path)
+
+
+def save_mesh(mesh: Any, path: str) -> str:
+    """Write a ``pyvista.PolyData`` of triangles to ``path`` (``.stl``, ``.ply``,
+    ``.obj``, ``.vtp`` or ``.vtk``, by the suffix; binary where the format has
+    it). Returns the path.
+
+    Examples
+    --------
+    >>> import os, tempfile
+    >>> import implicitvox as iv
+    >>> from implicitvox import x, y, z
+    >>> m = iv.mesh(x * x + y * y + z * z - 1, resolution=8, bounds=((-1.2,) * 3, (1.2,) * 3))
+    >>> path = save_mesh(m, os.path.join(tempfile.mkdtemp(), "ball.stl"))
+    >>> import pyvista as pv
+    >>> pv.read(path).n_cells == m.n_cells
+    True
+    """
+    ext = os.path.splitext(str(path))[1].lower()
+    if ext not in MESH_FORMATS:
+        raise ValueError(f"unknown mesh file type {ext!r} for {path!r}; use one of "
+                         f"{MESH_FORMATS}")
+    validate.writable_path(path)
+    mesh.save(str(path))
     return str(path)
 
 

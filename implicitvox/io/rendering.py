@@ -1,4 +1,4 @@
-"""PyVista objects and off-screen pictures of voxels.
+"""PyVista objects and off-screen pictures of voxels and meshes.
 
 Rendering is headless: VTK draws through EGL (Mesa), set up before PyVista is
 imported. Each voxel is drawn as a point shaded by its normal, as Stolte
@@ -16,7 +16,7 @@ import numpy as np
 from .. import validate
 from ..octree.morton import CORNERS
 
-__all__ = ["to_pyvista", "render", "RenderError"]
+__all__ = ["to_pyvista", "render", "render_mesh", "RenderError"]
 
 os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
 
@@ -83,17 +83,9 @@ def render(vox: Any, path: str, *, window_size: Sequence[int] = (1024, 768),
     title : str, optional
         Text drawn in the corner.
     """
-    missing = _missing_libraries()
-    if missing:
-        raise RenderError("off-screen rendering needs the Debian packages "
-                          f"{' '.join(missing)} (apt-get install them)")
     path = validate.writable_path(path)
     pv = _pyvista()
-    try:
-        plotter = pv.Plotter(off_screen=True, window_size=list(window_size))
-    except Exception as err:  # VTK reports a failed context in many ways
-        raise RenderError(f"could not start an off-screen render window: {err}") from err
-    plotter.set_background(background)
+    plotter = _plotter(path, window_size, background)
     light = np.array([0.4, 0.5, 0.77])
     light /= np.linalg.norm(light)
     if vox.count == 0:
@@ -118,6 +110,55 @@ def render(vox: Any, path: str, *, window_size: Sequence[int] = (1024, 768),
     plotter.reset_camera()
     if vox.count:
         _frame(plotter, _sample_corners(vox), window_size)
+    plotter.screenshot(path)
+    plotter.close()
+    return path
+
+
+def _plotter(path: str, window_size: Sequence[int], background: str) -> Any:
+    """An off-screen plotter, or a :class:`RenderError` saying what is missing."""
+    missing = _missing_libraries()
+    if missing:
+        raise RenderError("off-screen rendering needs the Debian packages "
+                          f"{' '.join(missing)} (apt-get install them)")
+    pv = _pyvista()
+    try:
+        plotter = pv.Plotter(off_screen=True, window_size=list(window_size))
+    except Exception as err:  # VTK reports a failed context in many ways
+        raise RenderError(f"could not start an off-screen render window: {err}") from err
+    plotter.set_background(background)
+    return plotter
+
+
+#: triangles up to which :func:`render_mesh` draws edges by default
+EDGES_UP_TO = 60000
+
+
+def render_mesh(mesh: Any, path: str, *, window_size: Sequence[int] = (1024, 768),
+                color: str = "#d9a441", background: str = "white",
+                show_edges: Optional[bool] = None, title: Optional[str] = None) -> str:
+    """Render a triangle mesh (``pyvista.PolyData``) off screen to a PNG at
+    ``path``, flat shaded; returns the path. ``show_edges`` draws the triangles'
+    edges (default: when there are at most :data:`EDGES_UP_TO` triangles, so
+    they do not black out the picture)."""
+    if show_edges is None:
+        show_edges = mesh.n_cells <= EDGES_UP_TO
+    path = validate.writable_path(path)
+    plotter = _plotter(path, window_size, background)
+    if mesh.n_cells == 0:
+        plotter.add_text("no triangles", font_size=14, color="black")
+    else:
+        plotter.add_mesh(mesh, color=color, show_edges=show_edges, edge_color="#6b5428",
+                         line_width=0.5, smooth_shading=False)
+    if title:
+        plotter.add_text(title, font_size=10, color="black")
+    plotter.camera_position = "iso"
+    plotter.camera.elevation = 10
+    plotter.reset_camera()
+    if mesh.n_points:
+        points = np.asarray(mesh.points)
+        step = max(1, len(points) // 20000)
+        _frame(plotter, points[::step], window_size)
     plotter.screenshot(path)
     plotter.close()
     return path

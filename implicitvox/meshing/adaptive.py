@@ -16,13 +16,18 @@ is therefore built as in §5.2:
    the cell says the surface in it is one monotone sheet (every component of
    the gradient has one sign, or one component is bounded away from 0, so
    each line along that axis meets the surface once);
-3. a cell whose corners all have one sign, and whose gradient components all
-   have one sign, holds no surface point: ``f`` is monotone along every axis
-   over it, so its extremes are at corners, and the corners' enclosures
-   (outward rounded) exclude 0. It is dropped;
-4. every other cell is subdivided, down to ``refine`` levels below the
-   tolerance level; the cells still complex there are *uncertified* and
-   counted (see below).
+3. a cell whose corners all have one sign holds no surface point when the
+   corners' enclosures (outward rounded) stay beyond the *leak* that the
+   interval gradient allows (:func:`_monotone`; 0 where ``f`` is monotone
+   along every axis, so its extremes are at corners), when its subtree shows
+   that (:func:`_search`), or, for shapes with an exact test, when
+   the surface touches only its boundary (:func:`_touch_only`). It is
+   dropped;
+4. a cell without a sign change whose subtree shows one within three
+   levels (:func:`_search`) is subdivided, down to ``refine`` levels below
+   the tolerance level; one whose subtree shows none, but is not cleared
+   either, stays a *complex* leaf, as do cells still complex at the finest
+   level (see below).
 
 What this gives (the argument of §5.2, with this implementation's
 rounding). Every point ``p`` of the surface lies in a leaf: cells are only
@@ -35,8 +40,11 @@ ends have opposite signs), so every mesh point is within the largest of
 those cells' sizes of that zero. With every leaf no larger than ``h``, the
 two-sided Hausdorff distance is at most ``h`` in the max norm and ``h·√3``
 Euclidean. The exceptions are the uncertified cells (a surface detail
-smaller than a cell ``2**refine`` times smaller than ``h``, or a tangency):
-they are reported, never hidden. Signs at corners are those of the float64
+smaller than the search reaches, a tangency, or a zero set that changes no
+sign, such as the face two parts of a union share, which is no boundary of
+the solid): a complex leaf is covered when every point of it is within the
+bound of a vertex of a leaf around it; the others are reported, never
+hidden. Signs at corners are those of the float64
 point values, computed by one formula per lattice point, so neighbours agree.
 """
 from __future__ import annotations
@@ -69,6 +77,11 @@ _DEBUG = False
 #: a gradient component counts as one-signed when its other side is within this
 #: share of the largest component (an exact 0 rounded outward)
 _FLAT = 1e-9
+#: the shrink of a cell, relative to its size, for :func:`_touch_only`
+_SHRINK = 2.0 ** -20
+#: levels a cell without a sign change is searched below for one (3 resolves a
+#: sheet 0.1 of the tolerance thick: cells of tolerance / (8 √3) land in it)
+_SEARCH = 3
 
 
 @dataclass
@@ -94,8 +107,8 @@ class AdaptiveGrid:
         Sign change and one monotone sheet (the leaves above the finest level
         all are).
     complex : ndarray of bool, (n,)
-        Leaves at the finest level that the surface may meet but whose corners
-        show no sign change: they get no vertex, and the Hausdorff bound covers
+        Leaves that the surface may meet but whose corners show no sign change
+        (at the finest level, or where :func:`_search` found none below): they get no vertex, and the Hausdorff bound covers
         them only where a neighbour's vertex is near enough
         (:func:`implicitvox.meshing.contour.dual_contour` checks).
     cells_evaluated : int
@@ -187,18 +200,40 @@ def _children(grid: Grid, level: int, coords: np.ndarray, owner: Optional[np.nda
     return kids[inside], np.repeat(owner, 8)[inside]
 
 
-def _may_hold_surface(func: Function, grid: Grid, level: int, cells: np.ndarray,
-                      exact: Optional[Callable]) -> np.ndarray:
+def _touch_only(exact: Optional[Callable], grid: Grid, level: int, cells: np.ndarray
+                ) -> np.ndarray:
+    """True where the shape's exact test clears the cell shrunk by ``_SHRINK`` of
+    its size: the surface meets the closed cell on its boundary at most (a face
+    of the solid on a lattice plane). Such surface points are also in the cells
+    across that boundary; the corner sign convention (0 counts as outside) gives
+    the cells on the solid's side of such a face a sign change, so they hold
+    the vertex. Without an exact test, nothing is cleared."""
+    if exact is None or not len(cells):
+        return np.zeros(len(cells), dtype=bool)
+    lo, hi = grid.octant_boxes(level, cells)
+    lo, hi = np.stack(lo, 1), np.stack(hi, 1)
+    pad = (hi - lo) * _SHRINK
+    return np.asarray(exact(lo + pad, hi - pad)) != AMBIGUOUS
+
+
+def _search(func: Function, grid: Grid, level: int, cells: np.ndarray,
+            exact: Optional[Callable], levels: int) -> tuple[np.ndarray, np.ndarray]:
     """For cells without a sign change that no certificate empties: search their
-    subtrees down to ``grid.depth``. A cell is empty when every descendant is
-    rejected (interval or exact test, or corners beyond the leak); it may hold
-    surface when a descendant shows a sign change or stays undecided at the
-    finest level. Most such cells lie just beside the surface and empty in a
-    level or two; only the others need splitting."""
-    hold = np.zeros(len(cells), dtype=bool)
+    subtrees ``levels`` levels down (at most to ``grid.depth``).
+
+    Returns ``(shows, empty)``: a descendant shows a sign change (surface the
+    corners miss: a thin sheet, a bump through a face; the cell is split), or
+    every descendant is rejected (interval or exact test, corners beyond the
+    leak, boundary contact only; the cell is dropped). Cells with neither hold
+    a zero set that changes no sign this deep (a face shared by two parts of a
+    union, a tangency, detail below the search): complex leaves. Most such
+    cells lie just beside the surface and empty in a level or two."""
+    shows = np.zeros(len(cells), dtype=bool)
+    undecided = np.zeros(len(cells), dtype=bool)
     owner = np.arange(len(cells))
     current = cells
-    while len(current) and level < grid.depth:
+    stop = min(grid.depth, level + levels)
+    while len(current) and level < stop:
         current, owner = _children(grid, level, current, owner)
         level += 1
         states = classify(func, grid, level, current, exact, mean_value=True)
@@ -207,13 +242,14 @@ def _may_hold_surface(func: Function, grid: Grid, level: int, cells: np.ndarray,
             break
         inside = corner_values(func, grid, level, current) < 0
         change = inside.any(1) & ~inside.all(1)
-        hold[owner[change]] = True
+        shows[owner[change]] = True
         _, _, leak = _monotone(func, grid, level, current)
-        rest = ~change & ~hold[owner]
+        rest = ~change & ~shows[owner]
         rest[rest] = ~_corners_exclude(func, grid, level, current[rest], leak[rest])
+        rest[rest] = ~_touch_only(exact, grid, level, current[rest])
         current, owner = current[rest], owner[rest]
-    hold[owner] = True
-    return hold
+    undecided[owner] = True
+    return shows, ~shows & ~undecided
 
 
 #: the 26 neighbours' offsets
@@ -284,7 +320,7 @@ def adaptive_grid(func: Function, grid: Grid, refine: int, *,
     for level in range(top, depth + 1):
         if level > top and len(cells):
             states = np.concatenate([
-                classify(func, fine, level, cells[s:s + _CHUNK], exact_voxels, mean_value=True)
+                classify(func, fine, level, cells[s:s + _CHUNK], exact, mean_value=True)
                 for s in range(0, len(cells), _CHUNK)])
             evaluated += len(cells)
             cells = cells[states == AMBIGUOUS]
@@ -303,9 +339,15 @@ def adaptive_grid(func: Function, grid: Grid, refine: int, *,
         if test.any():
             empty[test] = _corners_exclude(func, fine, level, cells[test], leak[test])
         test = ~change & ~empty
+        if test.any():
+            empty[test] = _touch_only(exact, fine, level, cells[test])
+        stuck = np.zeros(len(cells), dtype=bool)     # complex, no sign change found below
+        test = ~change & ~empty
         if test.any() and level < depth:
-            empty[test] = ~_may_hold_surface(func, fine, level, cells[test], exact_voxels)
-        leaf = simple | ((level == depth) & ~empty)
+            shows, cleared = _search(func, fine, level, cells[test], exact, _SEARCH)
+            empty[test] = cleared
+            stuck[test] = ~shows & ~cleared
+        leaf = simple | stuck | ((level == depth) & ~empty)
         if _DEBUG:
             print(level, len(cells), "change", int(change.sum()), "weak", int(weak.sum()), "strict", int(strict.sum()), "simple", int(simple.sum()), "empty", int(empty.sum()), "nochange-notweak", int((~change & ~weak).sum()))
         if level < depth:

@@ -202,16 +202,20 @@ _AROUND = np.array([(i, j, k) for i in (-1, 0, 1) for j in (-1, 0, 1) for k in (
 
 def _uncovered(agrid: AdaptiveGrid, locator: "_Locator", vertex: np.ndarray,
                has_vertex: np.ndarray, lo: np.ndarray, hi: np.ndarray, bound: float) -> int:
-    """Complex leaves (finest level) whose farthest point is more than ``bound``
-    from the vertex of every leaf touching them."""
+    """Complex leaves whose farthest point is more than ``bound`` from the vertex
+    of every leaf touching them (one leaf probed per neighbour direction)."""
     cells = np.flatnonzero(agrid.complex)
     if not len(cells):
         return 0
     corners = np.stack([np.where(CORNERS[None, :, a] == 1, hi[cells, None, a], lo[cells, None, a])
                         for a in range(3)], -1)                       # (m, 8, 3)
     best = np.full(len(cells), np.inf)
+    shift = (agrid.grid.depth - agrid.levels[cells].astype(np.int64))[:, None]
     for offset in _AROUND:
-        j, _ = locator.find(agrid.coords[cells] + offset)
+        # the neighbour's finest cell nearest to this leaf
+        near = (agrid.coords[cells] + offset) << shift
+        near += np.where(offset < 0, (1 << shift) - 1, 0)
+        j, _ = locator.find(near)
         ok = j >= 0
         ok[ok] = has_vertex[j[ok]]
         if ok.any():

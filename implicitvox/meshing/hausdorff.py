@@ -3,9 +3,10 @@
 :func:`implicitvox.mesh` proves a Hausdorff bound; these measure it.
 
 * :func:`distance_to_surface` bounds from above each point's Euclidean
-  distance to the surface ``f = 0``: along a few directions (both ways along
-  the gradient; towards the 26 neighbours of a cube where that left more
-  than an eighth of the limit, as at sharp edges) it finds the nearest step where ``f`` changes sign and isolates the
+  distance to the surface ``f = 0``: along a few directions (down the
+  gradient towards the other sign; towards the 26 neighbours of a cube where that left more
+  than an eighth of the limit, as at sharp edges; 400 directions spread
+  over the sphere where a quarter, as near corners) it finds the nearest step where ``f`` changes sign and isolates the
   zero on that segment by bisection. A sign change on a segment holds a
   zero (``f`` continuous), and a sample where ``f`` is 0 is one, so the
   bound is certified, not estimated.
@@ -40,10 +41,12 @@ __all__ = ["distance_to_surface", "surface_points", "distance_to_mesh", "mesh_sa
 
 #: steps of the ladder along each direction, and bisection steps after it
 _LADDER = 32
-_BISECT = 24
+_BISECT = 12
 #: the 26 directions to the neighbours of a cube, tried after the gradient
 _AROUND = [(i, j, k) for i in (-1, 0, 1) for j in (-1, 0, 1) for k in (-1, 0, 1)
            if (i, j, k) != (0, 0, 0)]
+#: directions tried last, where the others left a bound above a quarter of the limit
+_MORE = 400
 
 
 def _values(func: Function, p: np.ndarray) -> np.ndarray:
@@ -63,12 +66,16 @@ def distance_to_surface(func: Function, points: np.ndarray, limit: float) -> np.
     g = np.broadcast_to(np.asarray(g, dtype=np.float64).reshape(3, -1), (3, n)).T
     norm = np.linalg.norm(g, axis=1, keepdims=True)
     unit = np.where((norm > 0) & np.isfinite(norm), g / np.where(norm > 0, norm, 1), 0)
-    directions = [unit, -unit] + [np.broadcast_to(np.array(c) / np.linalg.norm(c), (n, 3))
-                                  for c in _AROUND]
+    downhill = np.where((f0 > 0)[:, None], -unit, unit)     # towards the other sign
+    directions = [downhill] + [np.broadcast_to(np.array(c) / np.linalg.norm(c), (n, 3))
+                                  for c in _AROUND] + \
+        [np.broadcast_to(c, (n, 3)) for c in _sphere_directions(_MORE)]
     inside0 = f0 < 0
     for i, d in enumerate(directions):
-        # the others only where the gradient left a bound above an eighth of the limit
-        todo = (np.abs(d).sum(1) > 0) & (best > (0 if i < 2 else limit / 8))
+        # the 26 only where the gradient left more than an eighth of the limit, the
+        # many more only where a quarter (near corners, where no few directions aim)
+        floor = 0 if i < 1 else limit / 8 if i < 1 + len(_AROUND) else limit / 4
+        todo = (np.abs(d).sum(1) > 0) & (best > floor)
         if not todo.any():
             continue
         rows = np.flatnonzero(todo)
@@ -96,6 +103,15 @@ def distance_to_surface(func: Function, points: np.ndarray, limit: float) -> np.
     return best
 
 
+def _sphere_directions(count: int) -> np.ndarray:
+    """``count`` unit vectors spread evenly over the sphere (a Fibonacci lattice)."""
+    k = np.arange(count) + 0.5
+    z = 1 - 2 * k / count
+    angle = np.pi * (1 + 5 ** 0.5) * k
+    rho = np.sqrt(1 - z * z)
+    return np.stack([rho * np.cos(angle), rho * np.sin(angle), z], 1)
+
+
 def surface_points(func: Function, bounds: Any, resolution: int) -> np.ndarray:
     """Points on ``f = 0``: the bisected sign changes on the edges of a uniform
     ``resolution``-point lattice over ``bounds`` (per axis)."""
@@ -116,16 +132,18 @@ def surface_points(func: Function, bounds: Any, resolution: int) -> np.ndarray:
     return np.concatenate(out)
 
 
-def mesh_samples(points: np.ndarray, faces: np.ndarray, per_triangle: int = 2,
+def mesh_samples(points: np.ndarray, faces: np.ndarray, per_triangle: int = 1,
                  seed: int = 0) -> np.ndarray:
-    """The vertices, edge midpoints and ``per_triangle`` random points of each
-    triangle (uniform in barycentric coordinates)."""
+    """The vertices, the edges' midpoints and ``per_triangle`` random points of
+    each triangle (uniform over it)."""
     rng = np.random.default_rng(seed)
     a, b, c = (points[faces[:, i]] for i in range(3))
+    edges = np.unique(np.sort(np.concatenate([faces[:, [0, 1]], faces[:, [1, 2]],
+                                              faces[:, [2, 0]]]), axis=1), axis=0)
     r1 = np.sqrt(rng.random((len(faces), per_triangle, 1)))
     r2 = rng.random((len(faces), per_triangle, 1))
     inner = (1 - r1) * a[:, None] + r1 * (1 - r2) * b[:, None] + r1 * r2 * c[:, None]
-    return np.concatenate([points, 0.5 * (a + b), 0.5 * (b + c), 0.5 * (c + a),
+    return np.concatenate([points, 0.5 * (points[edges[:, 0]] + points[edges[:, 1]]),
                            inner.reshape(-1, 3)])
 
 

@@ -25,7 +25,7 @@ import numpy as np
 
 from .. import validate
 from ..eval.function import Function
-from ..expr.shape import as_shape, exact_classifier, voxel_classifier
+from ..expr.shape import as_shape, exact_classifier, expression_is_exact, voxel_classifier
 from ..octree.budget import memory_budget, refuse_over_budget
 from ..octree.grid import Grid, grid_of
 from ..octree.guard import MemoryGuard
@@ -96,7 +96,9 @@ def mesh(shape: Any, tolerance: Optional[float] = None,
     Raises
     ------
     ValueError
-        For bad options (the message names the parameter).
+        For bad options (the message names the parameter), and for solids whose
+        expression only bounds them (polyhedra: OpenSCAD's facets, imported
+        meshes), which have no point values to contour.
     MemoryError
         When the estimate, or the run, exceeds ``max_memory``.
     """
@@ -126,6 +128,11 @@ def mesh_grid(shape: Any, grid: Grid, *, refine: int = REFINE,
     import pyvista as pv
 
     shape = as_shape(shape)
+    if not expression_is_exact(shape):
+        raise ValueError("this solid holds polyhedra (OpenSCAD's facets, polyhedron(), imported "
+                         "meshes) whose expressions only bound them, and meshing needs the "
+                         "solid's own function: read OpenSCAD models with facets='true' (the "
+                         "true curves), or voxelize the solid")
     func = Function(shape.expr)
     exact, exact_voxels = exact_classifier(shape), voxel_classifier(shape)
     estimated = _estimate_leaves(func, grid, exact, prune)

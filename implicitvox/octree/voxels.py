@@ -203,6 +203,33 @@ class Voxels:
         return self.source.refine(self, levels, progress, max_memory)
 
     # -- outputs ------------------------------------------------------------------------
+    def to_mesh(self, tolerance: Optional[float] = None, *, refine: Optional[int] = None,
+                progress: Any = None, max_memory: Optional[int] = None) -> Any:
+        """Triangles of the shape's surface within a guaranteed Hausdorff distance
+        (:func:`implicitvox.mesh`), over these voxels' bounds.
+
+        With ``tolerance`` None the voxels are the largest cells (the bound is
+        ``√3`` voxel sizes); else the tolerance picks the cells. Needs the shape:
+        voxels of an implicit or csg shape (not read from a file, not of a
+        triangle mesh, whose triangles are its mesh).
+
+        Examples
+        --------
+        >>> import implicitvox as iv
+        >>> from implicitvox import x, y, z
+        >>> vox = iv.voxelize(x * x + y * y + z * z - 1, 16, bounds=((-1.2,) * 3, (1.2,) * 3))
+        >>> m = vox.to_mesh()
+        >>> m.n_cells > 100, round(float(m.field_data["linf_bound"][0]), 3)
+        (True, 0.15)
+        """
+        to_mesh = getattr(self.source, "to_mesh", None)
+        if to_mesh is None:
+            what = "were loaded from a file" if self.source is None else \
+                "came from triangles or patches (mesh them with their own triangles)"
+            raise ValueError(f"to_mesh needs an implicit shape: these voxels {what}; call "
+                             "implicitvox.mesh on the shape")
+        return to_mesh(self, tolerance, refine=refine, progress=progress, max_memory=max_memory)
+
     def to_pyvista(self, kind: str = "points"):
         """PyVista object: ``"points"`` (PolyData of centres, with normals) or
         ``"cubes"`` (UnstructuredGrid of voxel cells); see

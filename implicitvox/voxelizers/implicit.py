@@ -23,7 +23,9 @@ from ..version import __version__
 from ..eval.function import Function
 from ..eval.gradient import evaluate_gradients
 from ..expr.shape import as_shape, exact_classifier, voxel_classifier
+from ..meshing.mesher import REFINE, mesh, mesh_grid
 from ..octree import morton
+from ..octree.morton import MAX_BITS
 from ..octree.grid import Grid, grid_of, padded_bounds
 from ..octree.guard import MemoryGuard
 from ..octree.store import Octree
@@ -126,6 +128,22 @@ class ImplicitSource:
         coords = voxels.coords().astype(np.int32)
         return _run(self, grid, progress, start=(voxels.grid.depth, coords),
                     interior_before=voxels.interior, budget=memory_budget(max_memory))
+
+    def to_mesh(self, voxels: Voxels, tolerance: Optional[float] = None, *,
+                refine: Optional[int] = None, progress: Any = None,
+                max_memory: Optional[int] = None) -> Any:
+        """:func:`implicitvox.mesh` of the shape over the voxels' bounds: on their
+        grid, or on the grid ``tolerance`` picks."""
+        levels = REFINE if refine is None else validate.int_in(refine, "refine", 0, 12)
+        if tolerance is not None:
+            return mesh(self.shape, tolerance, bounds=voxels.grid.bounds, refine=levels,
+                        progress=progress, max_memory=max_memory,
+                        prune=self.options["prune"])
+        if voxels.grid.depth + levels > MAX_BITS:
+            raise ValueError(f"to_mesh with refine={levels} on a depth-{voxels.grid.depth} "
+                             f"grid needs more than the octree's {MAX_BITS} levels; lower refine")
+        return mesh_grid(self.shape, voxels.grid, refine=levels, progress=progress,
+                         budget=memory_budget(max_memory), prune=self.options["prune"])
 
     def normals_at(self, points: np.ndarray) -> np.ndarray:
         """Unit gradients of the shape's function at ``points`` (n, 3)."""

@@ -143,3 +143,19 @@ def test_no_prune_gives_the_same_voxels(tmp_path, capsys):
         files.append(ivx.load(str(out_file)))
     assert files[0].metadata["tapes_built"] > 0 and files[1].metadata["tapes_built"] == 0
     assert np.array_equal(files[0].coords(), files[1].coords())
+
+
+def test_mesh_command_writes_a_mesh_and_voxelize_says_to_use_it(tmp_path, capsys):
+    import pyvista as pv
+    out = tmp_path / "ball.stl"
+    assert main(["mesh", "--example", "sphere", "--resolution", "16", "--out", str(out),
+                 "--quiet"]) == 0
+    said = capsys.readouterr().out
+    assert "triangles" in said and "Hausdorff distance <=" in said
+    assert pv.read(str(out)).n_cells > 100
+    assert main(["voxelize", "--example", "sphere", "--resolution", "16", "--out",
+                 str(tmp_path / "v.stl"), "--quiet"]) == 2
+    assert "implicitvox mesh" in capsys.readouterr().err
+    assert main(["mesh", "--example", "sphere", "--resolution", "16", "--out",
+                 str(tmp_path / "v.npz")]) == 2
+    assert "a mesh is written as one of" in capsys.readouterr().err
