@@ -36,7 +36,7 @@ from .adaptive import BYTES_PER_CELL, adaptive_grid
 from .contour import dual_contour
 from .manifold import split_nonmanifold
 
-__all__ = ["mesh", "mesh_grid", "REFINE"]
+__all__ = ["mesh", "mesh_grid", "estimate_mesh_memory", "REFINE"]
 
 #: levels below the tolerance's cells that complex cells may be split to
 REFINE = 4
@@ -135,9 +135,9 @@ def mesh_grid(shape: Any, grid: Grid, *, refine: int = REFINE,
                          "true curves), or voxelize the solid")
     func = Function(shape.expr)
     exact, exact_voxels = exact_classifier(shape), voxel_classifier(shape)
-    estimated = _estimate_leaves(func, grid, exact, prune)
+    estimated, need = estimate_mesh_memory(shape, grid, prune)
     what = f"meshing at {grid.shape}"
-    refuse_over_budget(estimated * BYTES_PER_CELL, budget, f"{what} (~{estimated:,} cells)")
+    refuse_over_budget(need, budget, f"{what} (~{estimated:,} cells)")
     guard = MemoryGuard(budget, what, BYTES_PER_CELL, estimated_voxels=estimated)
     t0 = time.perf_counter()
     share = progress if progress is not None else (lambda s: None)
@@ -166,9 +166,13 @@ def mesh_grid(shape: Any, grid: Grid, *, refine: int = REFINE,
     return out
 
 
-def _estimate_leaves(func: Function, grid: Grid, exact, prune: bool) -> int:
-    """Leaves of the adaptive grid, estimated from a pilot voxelization at depth
-    ``min(depth, 6)`` grown by Stolte's factor of 4 per level (§4.1.3)."""
+def estimate_mesh_memory(shape: Any, grid: Grid, prune: bool = True) -> tuple[int, int]:
+    """Estimated leaves and peak bytes of :func:`mesh_grid` on ``grid``: a pilot
+    voxelization at depth ``min(depth, 6)``, grown by Stolte's factor of 4 per
+    level (§4.1.3), times the leaves per surface voxel and the bytes per leaf."""
+    shape = as_shape(shape)
+    func = Function(shape.expr)
+    exact = exact_classifier(shape)
     depth = grid.depth
     pilot_depth = min(depth, _PILOT_DEPTH)
     scale = 1 << (depth - pilot_depth)
@@ -176,4 +180,5 @@ def _estimate_leaves(func: Function, grid: Grid, exact, prune: bool) -> int:
                  tuple(-(-n // scale) for n in grid.shape))
     found = len(subdivide(func, pilot, recheck=0.0, prune=prune, exact=exact).codes)
     cells = float(np.prod(grid.shape, dtype=np.float64))
-    return int(min(found * 4.0 ** (depth - pilot_depth), cells) * _LEAVES_PER_VOXEL)
+    leaves = int(min(found * 4.0 ** (depth - pilot_depth), cells) * _LEAVES_PER_VOXEL)
+    return leaves, leaves * BYTES_PER_CELL

@@ -5,8 +5,15 @@ option set, the OpenSCAD fixtures (both facet modes), their STL meshes, the
 Utah teapot and a tilted torus; it hashes the voxels, interior octants,
 normals, the interval enclosures of fixed boxes, the tape listings of the
 examples and the interval outputs of every opcode in float64 and float32.
-``python -m tests.golden.digests`` rewrites ``golden.json`` (do that only when
-a change of results is intended, and say which digests changed and why).
+``python -m tests.golden.digests`` rewrites ``golden.json`` and this CPU's set
+in ``golden_simd.json`` (do that only when a change of results is intended,
+and say which digests changed and why).
+
+The opcode outputs and box enclosures depend, in their last bits, on which of
+numpy's SIMD kernels run (AVX-512 and AVX2 machines differ by an ulp in
+``sin``, ``exp``, ``**``, ...; every one is still enclosed, outward rounded).
+They are kept per dispatch target (:func:`simd_target`); the voxels, interior
+and normals are the same on all and kept once.
 
 Every grid here is cubic and its bounds explicit, so the digests do not depend
 on the rule for default bounds.
@@ -21,6 +28,12 @@ import numpy as np
 
 HERE = pathlib.Path(__file__).parent
 GOLDEN = HERE / "golden.json"
+#: the digests that depend on numpy's SIMD code paths (its libm-like kernels and
+#: ``**`` differ by an ulp between, say, AVX-512 and AVX2 machines): one set per
+#: dispatch target, see :func:`simd_target`
+GOLDEN_SIMD = HERE / "golden_simd.json"
+#: the digest names that depend on the SIMD target
+SIMD_DEPENDENT = ("opcode/", "boxes/")
 FIXTURES = HERE.parent / "openscad"
 
 #: option sets for the expression examples
@@ -160,6 +173,22 @@ def _teapot_and_torus(out: dict) -> None:
             out[f"csg/tilted-torus/{res}/{k}"] = v
 
 
+def simd_target() -> str:
+    """The best of numpy's dispatch targets this CPU has (``X86_V4`` on AVX-512
+    machines, ``X86_V3`` on AVX2 ones, ...), which picks its transcendental kernels."""
+    from numpy._core._multiarray_umath import __cpu_dispatch__, __cpu_features__
+    import platform
+    found = [t for t in __cpu_dispatch__ if __cpu_features__.get(t)]
+    levels = [t for t in found if t.startswith("X86_V")] or found   # AVX512_ICL/SPR: X86_V4's
+    return f"{platform.machine()}:{levels[-1] if levels else 'baseline'}"
+
+
+def split(digests: dict[str, str]) -> tuple[dict[str, str], dict[str, str]]:
+    """``(portable, simd_dependent)`` digests."""
+    dependent = {k: v for k, v in digests.items() if k.startswith(SIMD_DEPENDENT)}
+    return {k: v for k, v in digests.items() if k not in dependent}, dependent
+
+
 def compute() -> dict[str, str]:
     """Every digest, by name."""
     out: dict[str, str] = {}
@@ -171,5 +200,9 @@ def compute() -> dict[str, str]:
 
 
 if __name__ == "__main__":
-    GOLDEN.write_text(json.dumps(compute(), indent=1, sort_keys=True) + "\n")
-    print(f"wrote {GOLDEN}")
+    portable, dependent = split(compute())
+    GOLDEN.write_text(json.dumps(portable, indent=1, sort_keys=True) + "\n")
+    sets = json.loads(GOLDEN_SIMD.read_text()) if GOLDEN_SIMD.exists() else {}
+    sets[simd_target()] = dependent
+    GOLDEN_SIMD.write_text(json.dumps(sets, indent=1, sort_keys=True) + "\n")
+    print(f"wrote {GOLDEN} and the {simd_target()} set of {GOLDEN_SIMD}")
