@@ -15,7 +15,8 @@ is therefore built as in §5.2:
    *simple*: some edge shows a sign change, and the interval gradient over
    the cell says the surface in it is one monotone sheet (every component of
    the gradient has one sign, or one component is bounded away from 0, so
-   each line along that axis meets the surface once);
+   each line along that axis meets the surface once), or has no enclosure
+   at all (sweeps, singular points: splitting would not tell more);
 3. a cell whose corners all have one sign holds no surface point when the
    corners' enclosures (outward rounded) stay beyond the *leak* that the
    interval gradient allows (:func:`_monotone`; 0 where ``f`` is monotone
@@ -68,9 +69,10 @@ from ..expr.shape import AMBIGUOUS
 
 __all__ = ["AdaptiveGrid", "adaptive_grid", "corner_values", "BYTES_PER_CELL"]
 
-#: bytes per leaf cell: coordinates, level, 8 corner values, flags, and the
+#: bytes per leaf cell at the peak (measured: 1.9 kB on sin(9θ)sin(18φ) - r at 256):
+#: coordinates, level, 8 corner values, flags, and the
 #: contouring's edges, crossings and quadric sums
-BYTES_PER_CELL = 640
+BYTES_PER_CELL = 2048
 #: cells classified per numpy call below the tolerance level
 _CHUNK = 1 << 14
 _DEBUG = False
@@ -153,7 +155,9 @@ def _monotone(func: Function, grid: Grid, level: int, coords: np.ndarray
     """``(weak, strict, leak)`` from the interval gradient over each cell.
 
     ``weak``: every component has one sign (up to ``_FLAT`` of the largest, the
-    outward rounding of an exact 0); ``strict``: some component is bounded away
+    outward rounding of an exact 0), or there is no gradient enclosure (the
+    sweeps' oracles give none; nor does a singular point), where splitting
+    would tell no more; ``strict``: some component is bounded away
     from 0; ``leak``: an upper bound of how far ``f`` inside the cell can
     pass the range of its corner values. For each axis, moving from a point
     to the face on the mostly-downhill side changes ``f`` by at most the
@@ -170,7 +174,9 @@ def _monotone(func: Function, grid: Grid, level: int, coords: np.ndarray
         leak = R.up_nonneg((one_sided * width).sum(0) * (1 + 1e-12))
         scale = np.maximum(np.abs(glo), np.abs(ghi)).max(0)
     leak = np.where(valid, leak, np.inf)
-    weak = valid & (one_sided <= _FLAT * scale).all(0)
+    # no gradient enclosure (a sweep's instances, a singular point): splitting tells no
+    # more, so the cell counts as one sheet ("weak")
+    weak = ~valid | (one_sided <= _FLAT * scale).all(0)
     strict = valid & ((glo > 0) | (ghi < 0)).any(0)
     return weak, strict, leak
 

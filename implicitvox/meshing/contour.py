@@ -29,6 +29,7 @@ Examples
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any, Callable, Optional
 
 import numpy as np
 
@@ -118,10 +119,13 @@ class _Locator:
         return found, level_of
 
 
-def dual_contour(func: Function, agrid: AdaptiveGrid, bound: float = np.inf) -> Contour:
+def dual_contour(func: Function, agrid: AdaptiveGrid, bound: float = np.inf,
+                 progress: Optional[Callable[[float], Any]] = None) -> Contour:
     """The triangles of the surface over the adaptive grid (module docstring);
     ``bound`` (Euclidean) is the distance a complex leaf's points may be from
-    the nearest vertex of a leaf around it (:attr:`Contour.uncovered`)."""
+    the nearest vertex of a leaf around it (:attr:`Contour.uncovered`);
+    ``progress`` is called with the share done after each stage."""
+    share = progress if progress is not None else (lambda s: None)
     grid, depth = agrid.grid, agrid.grid.depth
     n = agrid.count
     inside = agrid.corners < 0
@@ -151,6 +155,7 @@ def dual_contour(func: Function, agrid: AdaptiveGrid, bound: float = np.inf) -> 
     hi = np.stack([grid.edge(k, np.minimum((agrid.coords[:, k] + 1) * scale, grid.shape[k]))
                    for k in range(3)], 1)
     vertex = solve(leaf, points, normals, n, lo, hi)
+    share(0.6)
     # the cells around each edge: probes beside its midpoint, one per quadrant
     locator = _Locator(agrid)
     u, v = (axis + 1) % 3, (axis + 2) % 3
@@ -176,6 +181,7 @@ def dual_contour(func: Function, agrid: AdaptiveGrid, bound: float = np.inf) -> 
     # one polygon per minimal edge, though every cell around it lists it
     chosen = np.concatenate([_first_of_each(code, minimal & (axis == a)) for a in range(3)])
     n_unmatched = sum(len(_first_of_each(code, unmatched_edges & (axis == a))) for a in range(3))
+    share(0.85)
     quads = around[chosen]
     flip = ~inside[leaf[chosen], start_corner[chosen]]      # f >= 0 at the lower end: normal -axis
     quads[flip] = quads[flip][:, ::-1]

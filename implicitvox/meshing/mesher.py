@@ -142,9 +142,10 @@ def mesh_grid(shape: Any, grid: Grid, *, refine: int = REFINE,
     t0 = time.perf_counter()
     share = progress if progress is not None else (lambda s: None)
     agrid = adaptive_grid(func, grid, refine, exact=exact, exact_voxels=exact_voxels,
-                          progress=lambda s: share(0.8 * s), guard=guard, prune=prune)
+                          progress=lambda s: share(0.6 * s), guard=guard, prune=prune)
     h = max(grid.voxel_size)
-    contour = dual_contour(func, agrid, bound=h * math.sqrt(3))
+    contour = dual_contour(func, agrid, bound=h * math.sqrt(3),
+                           progress=lambda s: share(0.6 + 0.35 * s))
     share(1.0)
     points, triangles, non_manifold = split_nonmanifold(contour.points, contour.faces)
     faces = np.hstack([np.full((len(triangles), 1), 3, dtype=np.int64), triangles])

@@ -92,6 +92,7 @@ def _box_minus_cylinders():
 MODELS = {
     "sinsin34": (lambda: example("sinsin34"), 48),
     "gear": (lambda: example("gear"), 48),
+    "flange (repeat_polar)": (lambda: example("flange"), 32),
     "box-minus-cylinders": (_box_minus_cylinders, 32),
     "bracket.csg": (lambda: csg.read_openscad(str(FIXTURES / "bracket.csg")), 32),
 }
