@@ -103,13 +103,20 @@ def render(vox: Any, path: str, *, window_size: Sequence[int] = (1024, 768),
                              render_points_as_spheres=False, lighting=False)
         else:
             plotter.add_mesh(cloud, color=color, point_size=size)
+    return _finish(plotter, path, title, _sample_corners(vox) if vox.count else None,
+                   window_size)
+
+
+def _finish(plotter: Any, path: str, title: Optional[str], points: Optional[np.ndarray],
+            window_size: Sequence[int]) -> str:
+    """Title, the iso view framed on ``points`` (when any), the screenshot."""
     if title:
         plotter.add_text(title, font_size=10, color="black")
     plotter.camera_position = "iso"
     plotter.camera.elevation = 10
     plotter.reset_camera()
-    if vox.count:
-        _frame(plotter, _sample_corners(vox), window_size)
+    if points is not None and len(points):
+        _frame(plotter, points, window_size)
     plotter.screenshot(path)
     plotter.close()
     return path
@@ -150,18 +157,8 @@ def render_mesh(mesh: Any, path: str, *, window_size: Sequence[int] = (1024, 768
     else:
         plotter.add_mesh(mesh, color=color, show_edges=show_edges, edge_color="#6b5428",
                          line_width=0.5, smooth_shading=False)
-    if title:
-        plotter.add_text(title, font_size=10, color="black")
-    plotter.camera_position = "iso"
-    plotter.camera.elevation = 10
-    plotter.reset_camera()
-    if mesh.n_points:
-        points = np.asarray(mesh.points)
-        step = max(1, len(points) // 20000)
-        _frame(plotter, points[::step], window_size)
-    plotter.screenshot(path)
-    plotter.close()
-    return path
+    points = np.asarray(mesh.points)
+    return _finish(plotter, path, title, points[::max(1, len(points) // 20000)], window_size)
 
 
 #: the share of the window's half-width (or half-height) the model's box may fill
