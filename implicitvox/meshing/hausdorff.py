@@ -4,9 +4,9 @@
 
 * :func:`distance_to_surface` bounds from above each point's Euclidean
   distance to the surface ``f = 0``: along a few directions (down the
-  gradient towards the other sign; towards the 26 neighbours of a cube where that left more
-  than an eighth of the limit, as at sharp edges; 400 directions spread
-  over the sphere where a quarter, as near corners) it finds the nearest step where ``f`` changes sign and isolates the
+  gradient towards the other sign; towards the 26 neighbours of a cube where
+  that left more than half the distance to settle, as at sharp edges; 400
+  directions spread over the sphere where more, as near corners) it finds the nearest step where ``f`` changes sign and isolates the
   zero on that segment by bisection. A sign change on a segment holds a
   zero (``f`` continuous), and a sample where ``f`` is 0 is one, so the
   bound is certified, not estimated.
@@ -54,9 +54,17 @@ def _values(func: Function, p: np.ndarray) -> np.ndarray:
         return np.broadcast_to(evaluate_points(func.tape, *p.T), (len(p),))
 
 
-def distance_to_surface(func: Function, points: np.ndarray, limit: float) -> np.ndarray:
+def distance_to_surface(func: Function, points: np.ndarray, limit: float,
+                        settle: Optional[float] = None) -> np.ndarray:
     """Upper bounds of the Euclidean distances from ``points`` (n, 3) to ``f = 0``;
-    ``inf`` where no zero was found within ``limit`` of the point."""
+    ``inf`` where no zero was found within ``limit`` of the point.
+
+    The gradient's direction is tried for every point; the 26 directions to a
+    cube's neighbours where that left more than half of ``settle`` (default a
+    quarter of ``limit``), and 400 more where more than ``settle``: a bound at
+    most ``settle`` is as tight as the gradient gives, a larger one as tight as
+    427 directions give."""
+    settle = limit / 4 if settle is None else float(settle)
     points = np.asarray(points, dtype=np.float64)
     n = len(points)
     f0 = _values(func, points)
@@ -74,7 +82,7 @@ def distance_to_surface(func: Function, points: np.ndarray, limit: float) -> np.
     for i, d in enumerate(directions):
         # the 26 only where the gradient left more than an eighth of the limit, the
         # many more only where a quarter (near corners, where no few directions aim)
-        floor = 0 if i < 1 else limit / 8 if i < 1 + len(_AROUND) else limit / 4
+        floor = 0 if i < 1 else settle / 2 if i < 1 + len(_AROUND) else settle
         todo = (np.abs(d).sum(1) > 0) & (best > floor)
         if not todo.any():
             continue
@@ -159,10 +167,12 @@ def hausdorff(mesh: Any, func: Function, surface: np.ndarray,
     """``(mesh_to_surface, surface_to_mesh)``: the largest measured distance from
     the mesh's samples (:func:`mesh_samples`) to the surface (an upper bound per
     sample, :func:`distance_to_surface` within ``limit``, default 4 times the
-    mesh's ``hausdorff_bound``) and from the ``surface`` points to the mesh."""
+    mesh's ``hausdorff_bound``; every direction is tried where more than the bound)
+    and from the ``surface`` points to the mesh."""
+    bound = float(mesh.field_data["hausdorff_bound"][0])
     if limit is None:
-        limit = 4 * float(mesh.field_data["hausdorff_bound"][0])
+        limit = 4 * bound
     samples = mesh_samples(np.asarray(mesh.points), mesh.regular_faces)
-    there = distance_to_surface(func, samples, limit)
+    there = distance_to_surface(func, samples, limit, settle=bound)
     back = distance_to_mesh(mesh, surface) if len(surface) else np.zeros(1)
     return float(there.max()), float(back.max())

@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 import os
 import resource
 import subprocess
@@ -87,7 +88,7 @@ def child(name: str, res: int, method: str) -> dict:
     samples = mesh_samples(np.asarray(m.points), m.regular_faces)
     if len(samples) > _SAMPLES:
         samples = samples[rng.choice(len(samples), _SAMPLES, replace=False)]
-    there = distance_to_surface(f, samples, 8 * h)
+    there = distance_to_surface(f, samples, 8 * h, settle=math.sqrt(3) * h)
     b = grid.bounds
     surface = surface_points(f, b, _LATTICE)
     if len(surface) > _SAMPLES:
