@@ -60,6 +60,7 @@ from ..interval import rounding as R
 from ..eval.interval import evaluate_intervals
 from ..eval.mean_value import evaluate_interval_gradients
 from ..eval.point import evaluate_points
+from ..eval.tape import Tape
 from ..octree.grid import Grid
 from ..octree.guard import MemoryGuard
 from ..octree import morton
@@ -67,7 +68,7 @@ from ..octree.morton import CORNERS
 from ..octree.subdivide import classify, subdivide
 from ..expr.shape import AMBIGUOUS
 
-__all__ = ["AdaptiveGrid", "adaptive_grid", "corner_values", "BYTES_PER_CELL"]
+__all__ = ["AdaptiveGrid", "adaptive_grid", "corner_values", "per_tape", "BYTES_PER_CELL"]
 
 #: bytes per leaf cell at the peak (measured: 1.9 kB on sin(9θ)sin(18φ) - r at 256):
 #: coordinates, level, 8 corner values, flags, and the
@@ -75,7 +76,6 @@ __all__ = ["AdaptiveGrid", "adaptive_grid", "corner_values", "BYTES_PER_CELL"]
 BYTES_PER_CELL = 2048
 #: cells classified per numpy call below the tolerance level
 _CHUNK = 1 << 14
-_DEBUG = False
 #: a gradient component counts as one-signed when its other side is within this
 #: share of the largest component (an exact 0 rounded outward)
 _FLAT = 1e-9
@@ -115,6 +115,10 @@ class AdaptiveGrid:
         (:func:`implicitvox.meshing.contour.dual_contour` checks).
     cells_evaluated : int
         Cells classified below the tolerance level.
+    tapes : list of Tape
+        The pruned tapes of the voxelization (one per run of its voxels).
+    tape_index : ndarray of int64, (n,)
+        The tape valid over each leaf (that of the voxel holding it).
     """
 
     grid: Grid
@@ -125,6 +129,8 @@ class AdaptiveGrid:
     simple: np.ndarray
     complex: np.ndarray
     cells_evaluated: int
+    tapes: list
+    tape_index: np.ndarray
 
     @property
     def count(self) -> int:
@@ -138,19 +144,20 @@ class AdaptiveGrid:
         return h * np.exp2(self.grid.depth - self.levels.astype(np.float64))
 
 
-def corner_values(func: Function, grid: Grid, level: int, coords: np.ndarray) -> np.ndarray:
+def corner_values(func: Any, grid: Grid, level: int, coords: np.ndarray) -> np.ndarray:
     """``f`` (float64) at the 8 corners of cells ``coords`` at ``level`` of
     ``grid``; each lattice point's position comes from :meth:`Grid.edge`, so
-    every cell sharing a corner sees the same value."""
+    every cell sharing a corner sees the same value. ``func``: a
+    :class:`Function` or a tape valid over the cells."""
     scale = 1 << (grid.depth - level)
     idx = (coords[:, None, :].astype(np.int64) + CORNERS[None]) * scale     # (n, 8, 3)
     pos = [grid.edge(a, np.minimum(idx[..., a], grid.shape[a])) for a in range(3)]
     with np.errstate(all="ignore"):
-        values = evaluate_points(func.tape, pos[0].ravel(), pos[1].ravel(), pos[2].ravel())
+        values = evaluate_points(_tape(func), pos[0].ravel(), pos[1].ravel(), pos[2].ravel())
     return np.broadcast_to(values, (idx.shape[0] * 8,)).reshape(-1, 8).astype(np.float64)
 
 
-def _monotone(func: Function, grid: Grid, level: int, coords: np.ndarray
+def _monotone(func: Any, grid: Grid, level: int, coords: np.ndarray
               ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """``(weak, strict, leak)`` from the interval gradient over each cell.
 
@@ -166,7 +173,7 @@ def _monotone(func: Function, grid: Grid, level: int, coords: np.ndarray
     infinite where the mean value theorem may fail (domain edges, jumps)."""
     lo, hi = grid.octant_boxes(level, coords)
     with np.errstate(all="ignore"):
-        _, _, glo, ghi, valid = evaluate_interval_gradients(func.tape, lo, hi)
+        _, _, glo, ghi, valid = evaluate_interval_gradients(_tape(func), lo, hi)
         glo, ghi = np.asarray(glo, dtype=np.float64), np.asarray(ghi, dtype=np.float64)
         valid = np.asarray(valid) & np.isfinite(glo).all(0) & np.isfinite(ghi).all(0)
         one_sided = np.minimum(np.maximum(ghi, 0.0), np.maximum(-glo, 0.0))       # (3, n)
@@ -181,7 +188,7 @@ def _monotone(func: Function, grid: Grid, level: int, coords: np.ndarray
     return weak, strict, leak
 
 
-def _corners_exclude(func: Function, grid: Grid, level: int, coords: np.ndarray,
+def _corners_exclude(func: Any, grid: Grid, level: int, coords: np.ndarray,
                      leak: np.ndarray) -> np.ndarray:
     """True where the outward-rounded enclosures of ``f`` at all 8 corners lie
     beyond ``leak`` on one side of 0: then ``f`` has that sign on the whole cell."""
@@ -189,9 +196,43 @@ def _corners_exclude(func: Function, grid: Grid, level: int, coords: np.ndarray,
     idx = (coords[:, None, :].astype(np.int64) + CORNERS[None]) * scale
     pos = tuple(grid.edge(a, np.minimum(idx[..., a], grid.shape[a])).ravel() for a in range(3))
     with np.errstate(all="ignore"):
-        flo, fhi = evaluate_intervals(func.tape, pos, pos)
+        flo, fhi = evaluate_intervals(_tape(func), pos, pos)
         flo, fhi = flo.reshape(-1, 8), fhi.reshape(-1, 8)
         return (R.down(flo.min(1) - leak) > 0) | (R.up(fhi.max(1) + leak) < 0)
+
+
+def _tape(func: Any) -> Tape:
+    """The tape of a :class:`Function`, or the tape itself."""
+    return func.tape if isinstance(func, Function) else func
+
+
+def per_tape(tapes: list, tid: np.ndarray, fn: Callable, *arrays: np.ndarray,
+             chunk: int = _CHUNK) -> tuple:
+    """``fn(tape, *rows)`` over the rows of each tape (``tapes[tid[i]]`` is valid
+    over row ``i``), in chunks of ``chunk`` rows; the outputs (a tuple of arrays,
+    rows first) put back in row order. The pruned tapes of the voxelization
+    (:attr:`implicitvox.octree.subdivide.Subdivision.tapes`) give the same
+    values, enclosures and gradients as the whole tape over their octants, in
+    fewer operations (:mod:`implicitvox.eval.pruning`)."""
+    n = len(tid)
+    order = np.argsort(tid, kind="stable")
+    starts = np.searchsorted(tid[order], np.arange(len(tapes) + 1))
+    outs: Optional[list] = None
+    for t in range(len(tapes)):
+        group = order[starts[t]:starts[t + 1]]
+        for s in range(0, len(group), chunk):
+            rows = group[s:s + chunk]
+            got = fn(tapes[t], *(a[rows] for a in arrays))
+            got = got if isinstance(got, tuple) else (got,)
+            if outs is None:
+                outs = [np.empty((n,) + np.shape(g)[1:], dtype=np.asarray(g).dtype) for g in got]
+            for o, g in zip(outs, got):
+                o[rows] = g
+    if outs is None:
+        got = fn(tapes[0], *(a[:0] for a in arrays))
+        got = got if isinstance(got, tuple) else (got,)
+        outs = [np.asarray(g) for g in got]
+    return tuple(outs)
 
 
 def _children(grid: Grid, level: int, coords: np.ndarray, owner: Optional[np.ndarray] = None
@@ -223,9 +264,11 @@ def _touch_only(exact: Optional[Callable], grid: Grid, level: int, cells: np.nda
 
 
 def _search(func: Function, grid: Grid, level: int, cells: np.ndarray,
-            exact: Optional[Callable], levels: int) -> tuple[np.ndarray, np.ndarray]:
+            exact: Optional[Callable], levels: int, tapes: list, tid: np.ndarray
+            ) -> tuple[np.ndarray, np.ndarray]:
     """For cells without a sign change that no certificate empties: search their
-    subtrees ``levels`` levels down (at most to ``grid.depth``).
+    subtrees ``levels`` levels down (at most to ``grid.depth``), each with its
+    cell's tape (``tapes[tid[i]]``).
 
     Returns ``(shows, empty)``: a descendant shows a sign change (surface the
     corners miss: a thin sheet, a bump through a face; the cell is split), or
@@ -246,13 +289,19 @@ def _search(func: Function, grid: Grid, level: int, cells: np.ndarray,
         current, owner = current[states == AMBIGUOUS], owner[states == AMBIGUOUS]
         if not len(current):
             break
-        inside = corner_values(func, grid, level, current) < 0
+        at = level
+        inside = per_tape(tapes, tid[owner], lambda t, c: corner_values(t, grid, at, c),
+                          current)[0] < 0
         change = inside.any(1) & ~inside.all(1)
         shows[owner[change]] = True
-        _, _, leak = _monotone(func, grid, level, current)
         rest = ~change & ~shows[owner]
-        rest[rest] = ~_corners_exclude(func, grid, level, current[rest], leak[rest])
-        rest[rest] = ~_touch_only(exact, grid, level, current[rest])
+        if rest.any():
+            sub, sub_tid = current[rest], tid[owner[rest]]
+            _, _, leak = per_tape(tapes, sub_tid, lambda t, c: _monotone(t, grid, at, c), sub)
+            keep = ~per_tape(tapes, sub_tid,
+                             lambda t, c, w: _corners_exclude(t, grid, at, c, w), sub, leak)[0]
+            keep[keep] = ~_touch_only(exact, grid, level, sub[keep])
+            rest[rest] = keep
         current, owner = current[rest], owner[rest]
     undecided[owner] = True
     return shows, ~shows & ~undecided
@@ -320,7 +369,11 @@ def adaptive_grid(func: Function, grid: Grid, refine: int, *,
     voxels = subdivide(func, grid, exact=exact, exact_voxels=exact_voxels, guard=guard,
                        prune=prune, progress=(lambda s: share(0.6 * s)))
     cells = voxels.surface.astype(np.int64)
-    kept_levels, kept_coords, kept_corners, kept_simple, kept_complex = [], [], [], [], []
+    tapes = [t for _, t in voxels.tapes] or [func.tape]
+    tid = np.repeat(np.arange(len(voxels.tapes)), [n for n, _ in voxels.tapes]) \
+        if voxels.tapes else np.zeros(len(cells), dtype=np.int64)
+    kept: dict[str, list] = {k: [] for k in ("levels", "coords", "corners", "simple",
+                                             "complex", "tid")}
     evaluated = 0
     total = 0
     for level in range(top, depth + 1):
@@ -329,47 +382,51 @@ def adaptive_grid(func: Function, grid: Grid, refine: int, *,
                 classify(func, fine, level, cells[s:s + _CHUNK], exact, mean_value=True)
                 for s in range(0, len(cells), _CHUNK)])
             evaluated += len(cells)
-            cells = cells[states == AMBIGUOUS]
+            cells, tid = cells[states == AMBIGUOUS], tid[states == AMBIGUOUS]
         if not len(cells):
             break
-        values = np.concatenate([corner_values(func, fine, level, cells[s:s + _CHUNK])
-                                 for s in range(0, len(cells), _CHUNK)])
+        at = level
+        values = per_tape(tapes, tid, lambda t, c: corner_values(t, fine, at, c), cells)[0]
         inside = values < 0
         change = inside.any(1) & ~inside.all(1)
-        weak, strict, leak = (np.concatenate(parts) for parts in zip(*(
-            _monotone(func, fine, level, cells[s:s + _CHUNK])
-            for s in range(0, len(cells), _CHUNK))))
+        weak, strict, leak = per_tape(tapes, tid, lambda t, c: _monotone(t, fine, at, c), cells)
         simple = change & (weak | strict)
         empty = np.zeros(len(cells), dtype=bool)
         test = ~change & np.isfinite(leak)
         if test.any():
-            empty[test] = _corners_exclude(func, fine, level, cells[test], leak[test])
+            empty[test] = per_tape(tapes, tid[test],
+                                   lambda t, c, w: _corners_exclude(t, fine, at, c, w),
+                                   cells[test], leak[test])[0]
         test = ~change & ~empty
         if test.any():
             empty[test] = _touch_only(exact, fine, level, cells[test])
         stuck = np.zeros(len(cells), dtype=bool)     # complex, no sign change found below
         test = ~change & ~empty
         if test.any() and level < depth:
-            shows, cleared = _search(func, fine, level, cells[test], exact, _SEARCH)
+            shows, cleared = _search(func, fine, level, cells[test], exact, _SEARCH, tapes,
+                                     tid[test])
             empty[test] = cleared
             stuck[test] = ~shows & ~cleared
         leaf = simple | stuck | ((level == depth) & ~empty)
-        if _DEBUG:
-            print(level, len(cells), "change", int(change.sum()), "weak", int(weak.sum()), "strict", int(strict.sum()), "simple", int(simple.sum()), "empty", int(empty.sum()), "nochange-notweak", int((~change & ~weak).sum()))
         if level < depth:
             leaf &= ~_beside(cells, ~leaf & ~empty & ~change)
-        kept_levels.append(np.full(int(leaf.sum()), level, dtype=np.int8))
-        kept_coords.append(cells[leaf])
-        kept_corners.append(values[leaf])
-        kept_simple.append(simple[leaf])
-        kept_complex.append(~change[leaf])
+        for key, part in (("levels", np.full(int(leaf.sum()), level, dtype=np.int8)),
+                          ("coords", cells[leaf]), ("corners", values[leaf]),
+                          ("simple", simple[leaf]), ("complex", ~change[leaf]),
+                          ("tid", tid[leaf])):
+            kept[key].append(part)
         total += int(leaf.sum())
-        cells = _children(fine, level, cells[~leaf & ~empty]) if level < depth else cells[:0]
+        split = ~leaf & ~empty
+        if level < depth:
+            cells, tid = _children(fine, level, cells[split], tid[split])
+        else:
+            cells, tid = cells[:0], tid[:0]
         if guard is not None:
             guard.check(voxels=total, octants=len(cells))
         share(0.6 + 0.4 * (level - top + 1) / (refine + 1))
-    def join(parts, shape, dtype):
-        return np.concatenate(parts) if parts else np.zeros(shape, dtype=dtype)
-    return AdaptiveGrid(fine, top, join(kept_levels, (0,), np.int8),
-                        join(kept_coords, (0, 3), np.int64), join(kept_corners, (0, 8), np.float64),
-                        join(kept_simple, (0,), bool), join(kept_complex, (0,), bool), evaluated)
+    def join(key, shape, dtype):
+        return np.concatenate(kept[key]) if kept[key] else np.zeros(shape, dtype=dtype)
+    return AdaptiveGrid(fine, top, join("levels", (0,), np.int8), join("coords", (0, 3), np.int64),
+                        join("corners", (0, 8), np.float64), join("simple", (0,), bool),
+                        join("complex", (0,), bool), evaluated, tapes,
+                        join("tid", (0,), np.int64))

@@ -36,7 +36,7 @@ import numpy as np
 from ..eval.function import Function
 from ..octree import morton
 from ..octree.morton import CORNERS
-from .adaptive import AdaptiveGrid
+from .adaptive import AdaptiveGrid, per_tape
 from .edges import crossings
 from .qef import solve
 
@@ -149,7 +149,8 @@ def dual_contour(func: Function, agrid: AdaptiveGrid, bound: float = np.inf,
             one = rows[first]
             a_pos = np.stack([grid.edge(k, a_idx[one, k]) for k in range(3)], 1)
             b_pos = np.stack([grid.edge(k, b_idx[one, k]) for k in range(3)], 1)
-            p, nrm = crossings(func, a_pos, b_pos)
+            p, nrm = per_tape(agrid.tapes, agrid.tape_index[leaf[one]],
+                              lambda tape, a, b: crossings(tape, a, b), a_pos, b_pos)
             points[rows], normals[rows] = p[back.ravel()], nrm[back.ravel()]
     lo = np.stack([grid.edge(k, agrid.coords[:, k] * scale) for k in range(3)], 1)
     hi = np.stack([grid.edge(k, np.minimum((agrid.coords[:, k] + 1) * scale, grid.shape[k]))

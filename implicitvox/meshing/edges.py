@@ -21,6 +21,8 @@ Examples
 """
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 
 from ..eval.function import Function
@@ -30,18 +32,19 @@ from ..eval.point import evaluate_points
 __all__ = ["crossings", "STEPS"]
 
 #: bisection steps: the bracket is 2**-STEPS of the edge
-STEPS = 24
+STEPS = 16
 
 
-def crossings(func: Function, a: np.ndarray, b: np.ndarray, steps: int = STEPS
+def crossings(func: Any, a: np.ndarray, b: np.ndarray, steps: int = STEPS
               ) -> tuple[np.ndarray, np.ndarray]:
     """Crossing points ``(n, 3)`` and unit normals ``(n, 3)`` of edges ``a -> b``
-    whose ends have opposite signs (``f < 0`` at exactly one end).
+    whose ends have opposite signs (``f < 0`` at exactly one end); ``func`` is a
+    :class:`Function` or a tape valid over the edges.
 
     The normal is zero where the gradient is zero or not finite."""
     a = np.asarray(a, dtype=np.float64)
     b = np.asarray(b, dtype=np.float64)
-    tape = func.tape
+    tape = func.tape if isinstance(func, Function) else func
     n = len(a)
     if n == 0:
         return np.zeros((0, 3)), np.zeros((0, 3))

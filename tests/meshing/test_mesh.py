@@ -242,3 +242,26 @@ def test_vertex_splitting_separates_solids_that_share_an_edge():
     assert left == 0 and tm.is_watertight
     parts = tm.split(only_watertight=False)
     assert sorted(round(float(s.volume), 9) for s in parts) == [round(1 / 6, 9)] * 2
+
+
+def test_pruned_tapes_give_the_same_mesh_bit_for_bit(monkeypatch):
+    """Each cell is evaluated with the pruned tape of the voxel holding it; the
+    mesh is the one the whole tape gives (points and triangles, digests). Tapes
+    of any length are pruned at every level here, so small grids have many."""
+    import hashlib
+    from implicitvox.expr.examples import sphere_union
+    from implicitvox.meshing.adaptive import adaptive_grid
+    from implicitvox.octree import subdivide as subdivision
+    monkeypatch.setattr(subdivision, "PRUNE_MIN_LENGTH", 0)
+    monkeypatch.setattr(subdivision, "PRUNE_MIN_BELOW", 1)
+    monkeypatch.setattr(subdivision, "PRUNE_EVERY", 1)
+
+    def digest(m):
+        return hashlib.sha256(np.asarray(m.points).tobytes()
+                              + m.regular_faces.tobytes()).hexdigest()
+
+    shape = sphere_union(20)
+    grid = grid_of(shape.bounds, None, 64, None)
+    assert len(adaptive_grid(ivx.compile(shape.expr), grid, 0).tapes) >= 3
+    assert digest(ivx.mesh(shape, resolution=64)) == \
+        digest(ivx.mesh(shape, resolution=64, prune=False))
