@@ -64,7 +64,7 @@ from ..eval.tape import Tape
 from ..octree.grid import Grid
 from ..octree.guard import MemoryGuard
 from ..octree import morton
-from ..octree.morton import CORNERS
+from ..octree.morton import CORNERS, NEIGHBOURS
 from ..octree.subdivide import classify, subdivide
 from ..expr.shape import AMBIGUOUS
 
@@ -149,12 +149,18 @@ def corner_values(func: Any, grid: Grid, level: int, coords: np.ndarray) -> np.n
     ``grid``; each lattice point's position comes from :meth:`Grid.edge`, so
     every cell sharing a corner sees the same value. ``func``: a
     :class:`Function` or a tape valid over the cells."""
+    pos = corner_positions(grid, level, coords)
+    with np.errstate(all="ignore"):
+        values = evaluate_points(_tape(func), *pos)
+    return np.broadcast_to(values, (len(coords) * 8,)).reshape(-1, 8).astype(np.float64)
+
+
+def corner_positions(grid: Grid, level: int, coords: np.ndarray) -> tuple[np.ndarray, ...]:
+    """World ``x, y, z`` columns of the 8 corners of each cell (cell-major), by
+    :meth:`Grid.edge` on the finest lattice: one position per lattice point."""
     scale = 1 << (grid.depth - level)
     idx = (coords[:, None, :].astype(np.int64) + CORNERS[None]) * scale     # (n, 8, 3)
-    pos = [grid.edge(a, np.minimum(idx[..., a], grid.shape[a])) for a in range(3)]
-    with np.errstate(all="ignore"):
-        values = evaluate_points(_tape(func), pos[0].ravel(), pos[1].ravel(), pos[2].ravel())
-    return np.broadcast_to(values, (idx.shape[0] * 8,)).reshape(-1, 8).astype(np.float64)
+    return tuple(grid.edge(a, np.minimum(idx[..., a], grid.shape[a])).ravel() for a in range(3))
 
 
 def _monotone(func: Any, grid: Grid, level: int, coords: np.ndarray
@@ -192,9 +198,7 @@ def _corners_exclude(func: Any, grid: Grid, level: int, coords: np.ndarray,
                      leak: np.ndarray) -> np.ndarray:
     """True where the outward-rounded enclosures of ``f`` at all 8 corners lie
     beyond ``leak`` on one side of 0: then ``f`` has that sign on the whole cell."""
-    scale = 1 << (grid.depth - level)
-    idx = (coords[:, None, :].astype(np.int64) + CORNERS[None]) * scale
-    pos = tuple(grid.edge(a, np.minimum(idx[..., a], grid.shape[a])).ravel() for a in range(3))
+    pos = corner_positions(grid, level, coords)
     with np.errstate(all="ignore"):
         flo, fhi = evaluate_intervals(_tape(func), pos, pos)
         flo, fhi = flo.reshape(-1, 8), fhi.reshape(-1, 8)
@@ -307,9 +311,6 @@ def _search(func: Function, grid: Grid, level: int, cells: np.ndarray,
     return shows, ~shows & ~undecided
 
 
-#: the 26 neighbours' offsets
-_NEIGHBOURS = np.array([(i, j, k) for i in (-1, 0, 1) for j in (-1, 0, 1) for k in (-1, 0, 1)
-                        if (i, j, k) != (0, 0, 0)], dtype=np.int64)
 
 
 def _beside(cells: np.ndarray, split: np.ndarray) -> np.ndarray:
@@ -323,7 +324,7 @@ def _beside(cells: np.ndarray, split: np.ndarray) -> np.ndarray:
     if not split.any():
         return split
     codes = morton.encode(cells)
-    near = (cells[split][:, None, :] + _NEIGHBOURS[None]).reshape(-1, 3)
+    near = (cells[split][:, None, :] + NEIGHBOURS[None]).reshape(-1, 3)
     near = near[(near >= 0).all(1)]
     return split | np.isin(codes, morton.encode(near))
 

@@ -35,7 +35,7 @@ import numpy as np
 
 from ..eval.function import Function
 from ..octree import morton
-from ..octree.morton import CORNERS
+from ..octree.morton import CORNERS, NEIGHBOURS
 from .adaptive import AdaptiveGrid, per_tape
 from .edges import crossings
 from .qef import solve
@@ -202,9 +202,6 @@ def _first_of_each(code: np.ndarray, mask: np.ndarray) -> np.ndarray:
     return rows[first]
 
 
-#: offsets to the 26 neighbours
-_AROUND = np.array([(i, j, k) for i in (-1, 0, 1) for j in (-1, 0, 1) for k in (-1, 0, 1)
-                    if (i, j, k) != (0, 0, 0)], dtype=np.int64)
 
 
 def _uncovered(agrid: AdaptiveGrid, locator: "_Locator", vertex: np.ndarray,
@@ -218,7 +215,7 @@ def _uncovered(agrid: AdaptiveGrid, locator: "_Locator", vertex: np.ndarray,
                         for a in range(3)], -1)                       # (m, 8, 3)
     best = np.full(len(cells), np.inf)
     shift = (agrid.grid.depth - agrid.levels[cells].astype(np.int64))[:, None]
-    for offset in _AROUND:
+    for offset in NEIGHBOURS:
         # the neighbour's finest cell nearest to this leaf
         near = (agrid.coords[cells] + offset) << shift
         near += np.where(offset < 0, (1 << shift) - 1, 0)

@@ -34,6 +34,7 @@ import numpy as np
 from ..eval.function import Function
 from ..eval.gradient import evaluate_gradients
 from ..eval.point import evaluate_points
+from ..octree.morton import NEIGHBOURS
 from .edges import crossings
 
 __all__ = ["distance_to_surface", "surface_points", "distance_to_mesh", "mesh_samples",
@@ -42,9 +43,6 @@ __all__ = ["distance_to_surface", "surface_points", "distance_to_mesh", "mesh_sa
 #: steps of the ladder along each direction, and bisection steps after it
 _LADDER = 32
 _BISECT = 12
-#: the 26 directions to the neighbours of a cube, tried after the gradient
-_AROUND = [(i, j, k) for i in (-1, 0, 1) for j in (-1, 0, 1) for k in (-1, 0, 1)
-           if (i, j, k) != (0, 0, 0)]
 #: directions tried last, where the others left a bound above a quarter of the limit
 _MORE = 400
 
@@ -76,13 +74,13 @@ def distance_to_surface(func: Function, points: np.ndarray, limit: float,
     unit = np.where((norm > 0) & np.isfinite(norm), g / np.where(norm > 0, norm, 1), 0)
     downhill = np.where((f0 > 0)[:, None], -unit, unit)     # towards the other sign
     directions = [downhill] + [np.broadcast_to(np.array(c) / np.linalg.norm(c), (n, 3))
-                                  for c in _AROUND] + \
+                                  for c in NEIGHBOURS] + \
         [np.broadcast_to(c, (n, 3)) for c in _sphere_directions(_MORE)]
     inside0 = f0 < 0
     for i, d in enumerate(directions):
         # the 26 only where the gradient left more than an eighth of the limit, the
         # many more only where a quarter (near corners, where no few directions aim)
-        floor = 0 if i < 1 else settle / 2 if i < 1 + len(_AROUND) else settle
+        floor = 0 if i < 1 else settle / 2 if i < 1 + len(NEIGHBOURS) else settle
         todo = (np.abs(d).sum(1) > 0) & (best > floor)
         if not todo.any():
             continue

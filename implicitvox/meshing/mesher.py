@@ -176,9 +176,7 @@ def estimate_mesh_memory(shape: Any, grid: Grid, prune: bool = True) -> tuple[in
     exact = exact_classifier(shape)
     depth = grid.depth
     pilot_depth = min(depth, _PILOT_DEPTH)
-    scale = 1 << (depth - pilot_depth)
-    pilot = Grid(grid.origin, tuple(h * scale for h in grid.voxel_size),
-                 tuple(-(-n // scale) for n in grid.shape))
+    pilot = grid.coarser(depth - pilot_depth)
     found = len(subdivide(func, pilot, recheck=0.0, prune=prune, exact=exact).codes)
     cells = float(np.prod(grid.shape, dtype=np.float64))
     leaves = int(min(found * 4.0 ** (depth - pilot_depth), cells) * _LEAVES_PER_VOXEL)

@@ -140,6 +140,13 @@ class Grid:
         return Grid(self.origin, tuple(h / f for h in self.voxel_size),
                     tuple(n * f for n in self.shape))
 
+    def coarser(self, levels: int) -> "Grid":
+        """The grid whose voxels are ``2**levels`` of this one's per axis (same origin;
+        it covers this grid, reaching past it where a side is not a multiple)."""
+        f = 1 << levels
+        return Grid(self.origin, tuple(h * f for h in self.voxel_size),
+                    tuple(-(-n // f) for n in self.shape))
+
     def edge(self, axis: int, m: Any) -> Any:
         """World coordinate of voxel boundary ``m`` along ``axis`` (the one formula)."""
         return self.origin[axis] + np.asarray(m, dtype=np.float64) * self.voxel_size[axis]

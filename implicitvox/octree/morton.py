@@ -20,12 +20,15 @@ from __future__ import annotations
 import numpy as np
 from .. import batches
 
-__all__ = ["encode", "decode", "MAX_BITS", "CORNERS"]
+__all__ = ["encode", "decode", "MAX_BITS", "CORNERS", "NEIGHBOURS"]
 
 MAX_BITS = 21
 #: the 8 corners (or child octants) of a box in child-slot order: row ``c`` is
 #: ``(c & 1, (c >> 1) & 1, (c >> 2) & 1)``, 1 meaning the high end on that axis
 CORNERS = np.array([[c & 1, (c >> 1) & 1, (c >> 2) & 1] for c in range(8)], dtype=np.int64)
+#: offsets to the 26 cells that share a face, an edge or a corner with a cell
+NEIGHBOURS = np.array([(i, j, k) for i in (-1, 0, 1) for j in (-1, 0, 1) for k in (-1, 0, 1)
+                       if (i, j, k) != (0, 0, 0)], dtype=np.int64)
 CORNERS.flags.writeable = False
 _U = np.uint64
 _SPREAD = [(32, 0x1F00000000FFFF), (16, 0x1F0000FF0000FF), (8, 0x100F00F00F00F00F),

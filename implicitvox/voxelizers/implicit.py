@@ -26,7 +26,7 @@ from ..expr.shape import as_shape, exact_classifier, voxel_classifier
 from ..meshing.mesher import REFINE, mesh, mesh_grid
 from ..octree import morton
 from ..octree.morton import MAX_BITS
-from ..octree.grid import Grid, grid_of, padded_bounds
+from ..octree.grid import Grid, grid_of
 from ..octree.guard import MemoryGuard
 from ..octree.store import Octree
 from ..octree.subdivide import RECHECK, subdivide
@@ -59,9 +59,7 @@ def estimate_memory(func: Function, grid: Grid, normals: bool = False, prune: bo
     """
     depth = grid.depth
     pilot_depth = min(depth, _PILOT_DEPTH)
-    scale = 1 << (depth - pilot_depth)
-    pilot = Grid(grid.origin, tuple(h * scale for h in grid.voxel_size),
-                 tuple(-(-n // scale) for n in grid.shape))
+    pilot = grid.coarser(depth - pilot_depth)
     # The pilot's voxels are unions of grid voxels; crop effects are ignored.
     # No recheck: the pilot is cheaper and its count an upper estimate.
     found = len(subdivide(func, pilot, recheck=0.0, prune=prune).codes)
