@@ -48,3 +48,11 @@ class Primitive:
     def classify_boxes(self, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
         """EMPTY / FULL / AMBIGUOUS of boxes ``[lo, hi]`` (``(n, 3)`` each), exactly."""
         return classify_by_distance(self.distance, lo, hi, signed=self.signed)
+
+    def distance_function(self, norm: str) -> Optional[Callable]:
+        """The exact signed distance in ``norm`` (``"linf"``: ``distance(points,
+        weights)``; ``"euclidean"``: ``euclidean_distance(points)``), or None where
+        this primitive has none (:mod:`implicitvox.fields` then certifies one)."""
+        if norm == "linf":
+            return self.distance
+        return getattr(self, "euclidean_distance", None)

@@ -41,6 +41,7 @@ from .. import expr as ex
 
 from .ellipsoid import quadratic_roots
 from .classify import Primitive
+from .euclidean import meridian, segment_distance
 from .norm import as_points, as_weights
 
 __all__ = ["Cylinder", "Frustum"]
@@ -95,6 +96,19 @@ class Frustum(Primitive):
         ends = np.array([self.c, self.c + self.h * self.a])
         ext = self.r * np.sqrt(np.maximum(1 - self.a ** 2, 0))
         return tuple((ends.min(0) - ext).tolist()), tuple((ends.max(0) + ext).tolist())
+
+    def euclidean_distance(self, points: Any) -> np.ndarray:
+        """Signed Euclidean distance: in the point's meridian half-plane the solid is
+        the trapezoid ``0 <= s <= h, rho <= r1 + k s``, and the nearest surface point
+        lies on its bottom, side or top segment (the axis is no boundary)."""
+        m = meridian(as_points(points), self.c, self.a)
+        n = len(m)
+        corners = np.array([[0.0, 0.0], [self.r1, 0.0], [self.r2, self.h], [0.0, self.h]])
+        d = np.min([segment_distance(m, np.broadcast_to(corners[i], (n, 2)),
+                                     np.broadcast_to(corners[i + 1], (n, 2))) for i in range(3)],
+                   axis=0)
+        inside = (m[:, 1] >= 0) & (m[:, 1] <= self.h) & (m[:, 0] <= self.radius(m[:, 1]))
+        return np.where(inside, -d, d)
 
     # -- pieces ----------------------------------------------------------------------------
     def _inside(self, y):

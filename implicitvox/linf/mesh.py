@@ -36,6 +36,7 @@ from ..octree import morton
 from .classify import Primitive
 from .norm import as_points, as_weights, in_blocks
 from .polyhedron import triangle_distance
+from .euclidean import triangle_distance as triangle_euclidean
 from .. import batches
 
 __all__ = ["TriangleMesh"]
@@ -91,20 +92,40 @@ class TriangleMesh(Primitive):
         """Weighted max-norm distance (negative inside a closed mesh)."""
         p = as_points(points)
         w = as_weights(weights, len(p))
-        out = in_blocks(self._unsigned, p, w, _BLOCK)
-        if self.closed:
-            if self._winding is None:
-                self._winding = RayWinding(self.tri)
-            inside = self._winding(p) != 0
-            out = np.where(inside & (out > 0), -out, out)
-        return out
+        return self._signed(p, in_blocks(self._unsigned, p, w, _BLOCK))
 
-    def _unsigned(self, p: np.ndarray, w: np.ndarray) -> np.ndarray:
+    def euclidean_distance(self, points: Any) -> np.ndarray:
+        """Euclidean distance (negative inside a closed mesh): the same hierarchy walk,
+        with Euclidean bounds and point-triangle distances."""
+        p = as_points(points)
+        unsigned = in_blocks(lambda q, w: self._unsigned(q, w, euclidean=True), p,
+                             np.ones((len(p), 3)), _BLOCK)
+        return self._signed(p, unsigned)
+
+    def _signed(self, p: np.ndarray, unsigned: np.ndarray) -> np.ndarray:
+        if not self.closed:
+            return unsigned
+        if self._winding is None:
+            self._winding = RayWinding(self.tri)
+        inside = self._winding(p) != 0
+        return np.where(inside & (unsigned > 0), -unsigned, unsigned)
+
+    def _unsigned(self, p: np.ndarray, w: np.ndarray, euclidean: bool = False) -> np.ndarray:
+        if euclidean:
+            def gap(lo, hi, q, _w):
+                return np.linalg.norm(np.maximum(np.maximum(lo - q, q - hi), 0), axis=1)
+
+            def exact(q, tri, _w):
+                return triangle_euclidean(q, tri)
+        else:
+            def gap(lo, hi, q, ww):
+                return np.max(np.maximum(np.maximum(lo - q, q - hi), 0) / ww, axis=1)
+            exact = triangle_distance
         k = min(_NEAREST, len(self.tri))
-        _, near = self.tree.query(p / 1.0, k=k, p=np.inf)
+        _, near = self.tree.query(p / 1.0, k=k, p=2 if euclidean else np.inf)
         near = near.reshape(len(p), k)
         rows = np.repeat(np.arange(len(p)), k)
-        d = triangle_distance(p[rows], self.tri[near.ravel()], w[rows]).reshape(len(p), k)
+        d = exact(p[rows], self.tri[near.ravel()], w[rows]).reshape(len(p), k)
         upper = d.min(axis=1)
         # Varadhan §4.1: walk the hierarchy from the root, keeping (point, node) pairs
         # whose box is no farther than the point's upper bound (the lower bound culls)
@@ -116,9 +137,7 @@ class TriangleMesh(Primitive):
             node = (2 * np.repeat(node, 2)) + np.tile([0, 1], len(node))
             ok = node < len(blo)
             pt, node = pt[ok], node[ok]
-            q, ww = p[pt], w[pt]
-            gap = np.max(np.maximum(np.maximum(blo[node] - q, q - bhi[node]), 0) / ww, axis=1)
-            keep = gap <= upper[pt]
+            keep = gap(blo[node], bhi[node], p[pt], w[pt]) <= upper[pt]
             pt, node = pt[keep], node[keep]
         # the leaves' triangles, exactly
         pt = np.repeat(pt, _LEAF)
@@ -126,13 +145,10 @@ class TriangleMesh(Primitive):
         ok = idx < len(self.tri)
         pt, idx = pt[ok], idx[ok]
         cand = self.order[idx]
-        lo = self.tri[cand].min(axis=1)
-        hi = self.tri[cand].max(axis=1)
-        q, ww = p[pt], w[pt]
-        gap = np.max(np.maximum(np.maximum(lo - q, q - hi), 0) / ww, axis=1)
-        keep = gap <= upper[pt]
+        keep = gap(self.tri[cand].min(axis=1), self.tri[cand].max(axis=1), p[pt], w[pt]) \
+            <= upper[pt]
         pt, cand = pt[keep], cand[keep]
-        dist = triangle_distance(p[pt], self.tri[cand], w[pt])
+        dist = exact(p[pt], self.tri[cand], w[pt])
         best = upper.copy()
         np.minimum.at(best, pt, dist)
         return best

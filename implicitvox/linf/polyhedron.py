@@ -30,6 +30,7 @@ import numpy as np
 
 from .. import expr as ex
 from .classify import Primitive
+from .euclidean import triangle_distance as triangle_euclidean
 from .norm import as_points, as_weights, in_blocks
 from .. import batches
 
@@ -70,6 +71,7 @@ class ConvexPolyhedron(Primitive):
         self.axes = np.concatenate([u, -u])                    # (A, 3)
         proj = self.vertices @ self.axes.T                      # (m, A)
         self.low = proj.min(axis=0)                             # min_P u.x per axis
+        self._facets = None                                     # hull triangles, on demand
 
     @classmethod
     def from_points(cls, points: Any) -> "ConvexPolyhedron":
@@ -119,6 +121,27 @@ class ConvexPolyhedron(Primitive):
         d_out = np.max((self.low[None, :] - p @ self.axes.T) / h_axes, axis=1)
         return np.where(inside, d_in, d_out)
 
+    def euclidean_distance(self, points: Any) -> np.ndarray:
+        """Signed Euclidean distance: inside, to the nearest face plane (exact for a
+        convex solid); outside, to the nearest triangle of the hull's boundary."""
+        p = as_points(points)
+        return in_blocks(lambda q, _w: self._euclidean(q), p, np.ones((len(p), 3)), CHUNK)
+
+    def _euclidean(self, p: np.ndarray) -> np.ndarray:
+        if self._facets is None:
+            from scipy.spatial import ConvexHull
+            self._facets = self.vertices[ConvexHull(self.vertices).simplices]
+        excess = p @ self.normals.T - self.offsets[None, :]           # (n, F), <= 0 inside
+        d_in = np.max(excess, axis=1)
+        out = d_in > 0
+        d = d_in.copy()
+        if out.any():
+            q = p[out]
+            rows = np.repeat(np.arange(len(q)), len(self._facets))
+            tri = np.tile(self._facets, (len(q), 1, 1))
+            d[out] = triangle_euclidean(q[rows], tri).reshape(len(q), -1).min(axis=1)
+        return d
+
     @property
     def expr(self):
         """``max_f (n_f . x - d_f)``: the implicit function (a Shape for the voxelizer)."""
@@ -150,6 +173,10 @@ class HalfSpace(Primitive):
         p = as_points(points)
         w = as_weights(weights, len(p))
         return (p @ self.normal - self.offset) / (w @ np.abs(self.normal))
+
+    def euclidean_distance(self, points: Any) -> np.ndarray:
+        """Signed Euclidean distance ``(n.p - d) / |n|``."""
+        return (as_points(points) @ self.normal - self.offset) / np.linalg.norm(self.normal)
 
 
 

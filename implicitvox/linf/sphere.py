@@ -53,6 +53,10 @@ class Sphere(Primitive):
     def bounds(self):
         return tuple((self.center - self.r).tolist()), tuple((self.center + self.r).tolist())
 
+    def euclidean_distance(self, points: Any) -> np.ndarray:
+        """Signed Euclidean distance ``|p - c| - r`` (Bærentzen eq. 5)."""
+        return np.linalg.norm(as_points(points) - self.center, axis=1) - self.r
+
     def distance(self, points: Any, weights: Any = None) -> np.ndarray:
         p = as_points(points)
         w = as_weights(weights, len(p))

@@ -43,6 +43,7 @@ import numpy as np
 from .. import expr as ex
 
 from .classify import Primitive
+from .euclidean import meridian
 from .norm import as_points, as_weights, in_blocks
 from .torus_frame import TorusFrame
 
@@ -113,6 +114,19 @@ class Torus(Primitive):
         across = np.sqrt(np.maximum(1.0 - self.unit_axis ** 2, 0.0))  # the core circle's extent
         half = self.R * across + self.r
         return tuple((self.center - half).tolist()), tuple((self.center + half).tolist())
+
+    def distance_function(self, norm: str):
+        """As :meth:`Primitive.distance_function`; a spindle torus (``R < r``) has no
+        Euclidean one here (its tube surface runs through its own inside)."""
+        if norm == "euclidean" and self.R < self.r:
+            return None
+        return super().distance_function(norm)
+
+    def euclidean_distance(self, points: Any) -> np.ndarray:
+        """Signed Euclidean distance ``hypot(rho - R, s) - r`` of a ring torus, from the
+        point's meridian coordinates (:func:`implicitvox.linf.euclidean.meridian`)."""
+        m = meridian(as_points(points), self.center, self.unit_axis)
+        return np.hypot(m[:, 0] - self.R, m[:, 1]) - self.r
 
     def distance(self, points: Any, weights: Any = None) -> np.ndarray:
         p = as_points(points)

@@ -1,0 +1,13 @@
+"""Distance fields with a known error (Varadhan §4.2; Bærentzen et al. §3-§6).
+
+* :mod:`.bricks` - the narrow band in bricks of 8³ samples;
+* :mod:`.kernels` - exact, box-test and certified distances, per kind of shape;
+* :mod:`.certified` - lower and upper bounds by interval branch and bound;
+* :mod:`.field` - ``DistanceField``: look-ups, trilinear reconstruction,
+  gradients, the isosurface, dense outputs;
+* :mod:`.sampled` - ``distance_field``.
+"""
+from .field import DistanceField
+from .sampled import distance_field
+
+__all__ = ["DistanceField", "distance_field"]
