@@ -194,6 +194,15 @@ class Solid:
                             "primitives have one (booleans classify boxes leaf by leaf)")
         return prim.distance(points, weights)
 
+    def distance_function(self, norm: str) -> Optional[Callable]:
+        """The exact signed distance in ``norm`` (``"linf"`` or ``"euclidean"``) of a
+        single primitive under transforms (:meth:`implicitvox.linf.Primitive.distance_function`),
+        or None (booleans, blends, or a primitive without one, such as a scaled sphere's
+        ellipsoid in the Euclidean norm): :func:`implicitvox.distance_field` then uses
+        the exact box test or certifies the distances."""
+        prim = world_primitive(self)
+        return None if prim is None else prim.distance_function(norm)
+
     # -- scenes ------------------------------------------------------------------------
     def scene_node(self) -> dict:
         """This node of a JSON scene (:mod:`csg.scene`); each kind of solid writes its own."""

@@ -32,7 +32,9 @@ from .voxelizers.implicit import voxelize
 from .voxelizers.mesh import voxelize_mesh
 from .voxelizers.bezier import voxelize_bezier
 from .meshing.mesher import mesh
+from .fields import DistanceField, Suitability, distance_field, suitability
 from .io.files import load
+from .io.field_files import load_field
 
 __all__ = [
     "Expr", "constant", "wrap", "x", "y", "z",
@@ -41,7 +43,8 @@ __all__ = [
     "radius", "elevation", "repeat", "repeat_polar",
     "voxelize", "voxelize_mesh", "mesh", "winding_numbers", "BezierPatch", "voxelize_bezier",
     "utah_teapot", "linf", "linf_distance", "Voxels", "Grid", "Octree", "PointerOctree", "load",
-    "Shape", "EMPTY", "FULL", "AMBIGUOUS",
+    "Shape", "EMPTY", "FULL", "AMBIGUOUS", "distance_field", "DistanceField", "load_field",
+    "suitability", "Suitability",
     "abs", "acos", "asin", "atan", "atan2", "clip", "cos", "exp", "floor", "hypot", "log",
     "max", "min", "sin", "sqrt", "square", "tan",
 ]

@@ -28,6 +28,7 @@ LAYERS = [
     ("implicitvox.linf",),
     ("implicitvox.meshing",),
     ("implicitvox.voxelizers",),
+    ("implicitvox.fields",),
     ("implicitvox.io",),
     ("implicitvox",),
 ]
@@ -39,7 +40,8 @@ IMPLICITVOX_ALL = [
     "radius", "elevation", "repeat", "repeat_polar",
     "voxelize", "voxelize_mesh", "winding_numbers", "BezierPatch", "voxelize_bezier",
     "utah_teapot", "linf", "linf_distance", "Voxels", "Grid", "Octree", "PointerOctree", "load",
-    "mesh", "Shape", "EMPTY", "FULL", "AMBIGUOUS",
+    "mesh", "Shape", "EMPTY", "FULL", "AMBIGUOUS", "distance_field", "DistanceField", "load_field",
+    "suitability", "Suitability",
     "abs", "acos", "asin", "atan", "atan2", "clip", "cos", "exp", "floor", "hypot", "log",
     "max", "min", "sin", "sqrt", "square", "tan",
 ]

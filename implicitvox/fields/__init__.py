@@ -5,9 +5,14 @@
 * :mod:`.certified` - lower and upper bounds by interval branch and bound;
 * :mod:`.field` - ``DistanceField``: look-ups, trilinear reconstruction,
   gradients, the isosurface, dense outputs;
-* :mod:`.sampled` - ``distance_field``.
+* :mod:`.sampled` - ``distance_field``;
+* :mod:`.errors` - the analytic and empirical error bounds (Bærentzen §6);
+* :mod:`.suitability` - the S_r-open / S_r-closed criterion (Bærentzen §4-§5).
 """
 from .field import DistanceField
 from .sampled import distance_field
+from .errors import analytic_error_bound, sphere_reconstruction_errors
+from .suitability import Suitability, suitability
 
-__all__ = ["DistanceField", "distance_field"]
+__all__ = ["DistanceField", "distance_field", "analytic_error_bound",
+           "sphere_reconstruction_errors", "Suitability", "suitability"]

@@ -19,8 +19,8 @@ Examples
 >>> field = iv.distance_field(linf.Sphere((0, 0, 0), 1.0), 32, band=2)
 >>> field.kind, field.max_error
 ('exact', 0.0)
->>> float(field.sample(np.array([[0.0, 0.0, 1.1]]))[0].round(3))
-0.1
+>>> float(field.sample(np.array([[0.0, 0.0, 0.95]]))[0].round(3))    # inside: negative
+-0.05
 """
 from __future__ import annotations
 
