@@ -40,6 +40,7 @@ True
 """
 from __future__ import annotations
 
+import itertools
 from typing import Any, Callable, Optional
 
 import numpy as np
@@ -157,9 +158,10 @@ def certified_distances(func: Function, points: np.ndarray, norm: str, weights: 
         Boxes whose union holds every surface point within ``limit`` of a point
         (the voxelizer's surface voxels).
     limit : float
-        Distances beyond this are not wanted: such a point gets ``±limit`` and
-        error 0 when no surface is nearer (its bound is proved), as OpenVDB
-        clamps to its background.
+        Where to look first: the pairs are the boxes within ``limit`` (or the
+        point's Newton bound); a point with no zero proved within it is searched
+        again 4 times farther, up to the boxes' whole extent. A point with no
+        surface anywhere in the boxes gets ``inf``.
     tolerance : float
         Stop refining a point when ``U - L <= tolerance``.
     stats : dict, optional
@@ -169,8 +171,8 @@ def certified_distances(func: Function, points: np.ndarray, norm: str, weights: 
     Returns
     -------
     value, error : ndarray (n,)
-        ``|value - d| <= error`` for the true signed distance ``d`` (clamped to
-        ``limit``).
+        ``|value - d| <= error`` for the true signed distance ``d`` to the surface
+        held in the boxes.
     """
     from scipy.spatial import cKDTree
     nm = _Norm(norm)
@@ -189,18 +191,27 @@ def certified_distances(func: Function, points: np.ndarray, norm: str, weights: 
         else 0.0
     tree = cKDTree(0.5 * (boxes_lo + boxes_hi)) if len(boxes_lo) else None
     scale = float(np.max(boxes_hi - boxes_lo)) if len(boxes_lo) else 1.0
+    span = np.concatenate([boxes_hi, p]).max(axis=0) - np.concatenate([boxes_lo, p]).min(axis=0) \
+        if len(boxes_lo) else np.zeros(3)
+    max_reach = max(limit, float(np.max(span / (1.0 if nm.euclidean else np.min(w)))) * 2.0)
     sign = _point_signs(tape, p)
     stats = {} if stats is None else stats
     stats.setdefault("pairs", 0)
     stats.setdefault("capped", 0)
     for s in range(0, n, _BLOCK):
-        rows = slice(s, min(s + _BLOCK, n))
-        lo_b, up_b = _bracket(tape, nm, p[rows], w[rows], tree, boxes_lo, boxes_hi, half_diag,
-                              scale, limit, tolerance, max_levels, stats)
-        up_b = np.minimum(up_b, limit)
-        lo_b = np.minimum(lo_b, up_b)
-        value[rows] = 0.5 * (lo_b + up_b)
-        error[rows] = 0.5 * (up_b - lo_b)
+        rows = np.arange(s, min(s + _BLOCK, n))
+        reach = limit
+        while len(rows):
+            lo_b, up_b = _bracket(tape, nm, p[rows], w[rows], tree, boxes_lo, boxes_hi,
+                                  half_diag, scale, reach, tolerance, max_levels, stats)
+            value[rows] = 0.5 * (lo_b + up_b)
+            error[rows] = 0.5 * (up_b - lo_b)
+            # no zero proved within reach: search farther (all the boxes at the end)
+            rows = rows[~(up_b <= reach)]
+            if reach >= max_reach:
+                value[rows], error[rows] = np.inf, np.inf
+                break
+            reach = min(4 * reach, max_reach)
         if progress is not None:
             progress(min(1.0, (s + _BLOCK) / n))
     return sign * value, error
@@ -228,31 +239,54 @@ def _bracket(tape, nm: _Norm, p, w, tree, boxes_lo, boxes_hi, half_diag, scale, 
     reach = np.minimum(upper, limit)
     euclid_reach = reach * (1.0 if nm.euclidean else np.sqrt(3) * float(np.max(w))) + half_diag
     found = tree.query_ball_point(p, euclid_reach)
-    counts = np.fromiter((len(f) for f in found), dtype=np.int64, count=n)
+    counts = np.fromiter(map(len, found), dtype=np.int64, count=n)
     pt = np.repeat(np.arange(n), counts)
-    box = np.fromiter((i for f in found for i in f), dtype=np.int64, count=int(counts.sum()))
+    box = np.fromiter(itertools.chain.from_iterable(found), dtype=np.int64,
+                      count=int(counts.sum()))
     lo, hi = boxes_lo[box], boxes_hi[box]
-    open_ = np.ones(n, dtype=bool)          # points whose pairs are still refined
-    for level in range(max_levels + 1):
+    lower = np.where(counts == 0, reach, 0.0)     # no box within reach: nothing nearer
+    state = {"upper": upper, "lower": lower, "open": counts > 0}
+    _refine(tape, nm, p, w, pt, lo, hi, 0, state, limit, tolerance, max_levels, stats)
+    lower, upper = state["lower"], state["upper"]
+    # outward: a relative margin, and one for the roundings of coordinates of this size
+    slack = _MARGIN * (1.0 + float(np.max(np.abs(p))))
+    return np.maximum(lower * (1 - _MARGIN) - slack, 0.0), upper
+
+
+def _refine(tape, nm, p, w, pt, lo, hi, level, state, limit, tolerance, max_levels, stats):
+    """Bound, prune and split the pairs ``(pt, box)`` level by level; where the children
+    would exceed :data:`MAX_PAIRS`, the points are halved and each half refined on its
+    own (a point's pairs stay together, so its bounds come from all of them)."""
+    upper, lower, open_ = state["upper"], state["lower"], state["open"]
+    while len(pt):
+        mine = np.unique(pt)
         lb, cand = _pair_bounds(tape, nm, p[pt], w[pt], lo, hi)
         np.minimum.at(upper, pt, cand)
         reach = np.minimum(upper, limit)
         keep = np.isfinite(lb) & (lb <= reach[pt])
         pt, lo, hi, lb = pt[keep], lo[keep], hi[keep], lb[keep]
-        best = np.full(n, np.inf)
+        best = np.full(len(p), np.inf)
         np.minimum.at(best, pt, lb)
-        lower = np.where(open_, np.minimum(best, reach), lower)
-        open_ &= reach - lower > tolerance
+        lower[mine] = np.where(open_[mine], np.minimum(best[mine], reach[mine]), lower[mine])
+        open_[mine] &= reach[mine] - lower[mine] > tolerance
         still = open_[pt]
         pt, lo, hi = pt[still], lo[still], hi[still]
         if level == max_levels or not len(pt):
-            break
-        if len(pt) * 8 > MAX_PAIRS:
-            stats["capped"] += int(open_.sum())
-            break
+            return
         pt, lo, hi = _split(pt, lo, hi)
+        level += 1
         stats["pairs"] += len(pt)
-    return lower * (1 - _MARGIN), upper
+        if len(pt) > MAX_PAIRS:
+            points = np.unique(pt)
+            if len(points) == 1:            # one point's pairs alone are too many: stop here
+                stats["capped"] += 1
+                return
+            first = pt < points[len(points) // 2]
+            _refine(tape, nm, p, w, pt[first], lo[first], hi[first], level, state, limit,
+                    tolerance, max_levels, stats)
+            _refine(tape, nm, p, w, pt[~first], lo[~first], hi[~first], level, state, limit,
+                    tolerance, max_levels, stats)
+            return
 
 
 def _split(pt, lo, hi):

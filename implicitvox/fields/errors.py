@@ -15,7 +15,7 @@
 Examples
 --------
 >>> round(float(analytic_error_bound(3.0)), 4)
-0.2954
+0.2958
 >>> stats = sphere_reconstruction_errors(4.0, offsets=2, rays=50)
 >>> stats["max"] < analytic_error_bound(4.0)
 True

@@ -145,6 +145,7 @@ class DistanceField:
         p = validate.points(points)
         h = np.asarray(self.grid.voxel_size)
         u = (p - np.asarray(self.grid.origin)) / h - 0.5          # in sample units
+        u = np.where(np.abs(u - np.round(u)) < 1e-9, np.round(u), u)  # on a sample: exactly
         base = np.floor(u).astype(np.int64)
         return base, u - base
 
@@ -156,7 +157,7 @@ class DistanceField:
         for corner in np.ndindex(2, 2, 2):
             c = np.asarray(corner)
             weight = np.prod(np.where(c, t, 1 - t), axis=1)
-            out += weight * self.at(base + c)
+            out += np.where(weight > 0, weight * self.at(base + c), 0.0)
         return out
 
     def gradient(self, points: Any) -> np.ndarray:

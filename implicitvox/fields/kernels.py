@@ -80,7 +80,8 @@ def linf_by_box_test(classify: Callable, points: np.ndarray, weights: Any,
 
     def meets(t: np.ndarray) -> np.ndarray:
         half = t[:, None] * w
-        return classify(p - half, p + half) == AMBIGUOUS
+        with np.errstate(over="ignore", divide="ignore", invalid="ignore"):
+            return classify(p - half, p + half) == AMBIGUOUS
 
     hi = np.full(n, limit if np.isfinite(limit) else 1.0)
     if not np.isfinite(limit):          # grow until every cube meets the surface
@@ -103,7 +104,8 @@ def linf_by_box_test(classify: Callable, points: np.ndarray, weights: Any,
     at_lo = meets(t_lo)
     t = np.where(at_lo, t_lo, t_hi)
     # the sign: the largest cube that does not meet the surface is inside or outside
-    inside = classify(p - t_lo[:, None] * w, p + t_lo[:, None] * w) == FULL
+    with np.errstate(over="ignore", divide="ignore", invalid="ignore"):
+        inside = classify(p - t_lo[:, None] * w, p + t_lo[:, None] * w) == FULL
     far = ~meets(hi)
     t = np.where(far, hi, t)
     return np.where(inside & ~at_lo, -t, t), np.where(at_lo | far, 0.0, t_hi - t_lo)

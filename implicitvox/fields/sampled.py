@@ -134,13 +134,13 @@ def distance_field(shape: Any, resolution: Union[int, tuple[int, int, int], None
                        f"a distance field of {len(keys):,} bricks at {grid.shape}")
     limit = (band + 1) * float(h.max()) * (math.sqrt(3) if norm == "euclidean" else 1.0)
 
-    func = Function(target.expr)
-    boxes: list = []
+    compiled: list = []          # the function and the surface boxes, built on first use
 
     def certify(points, w):
-        if not boxes:
-            boxes.extend(_surface_boxes(vox))
-        return certified_distances(func, points, norm, w, *boxes, limit=limit, tolerance=tol)
+        if not compiled:
+            compiled.extend([Function(target.expr), *_surface_boxes(vox)])
+        return certified_distances(compiled[0], points, norm, w, compiled[1], compiled[2],
+                                   limit=limit, tolerance=tol)
 
     kernel = choose_kernel(target, norm, certify)
     coords = brick_coords(keys)[active]

@@ -1,0 +1,243 @@
+"""Distance fields: measured against analytic distances, brute force and independent oracles."""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+import pyvista as pv
+
+import csg
+import implicitvox as iv
+from implicitvox import linf, x, y, z
+from implicitvox.fields.bricks import band_bricks
+from implicitvox.fields.kernels import linf_by_box_test
+from implicitvox.linf.euclidean import triangle_distance as triangle_euclidean
+from implicitvox.triangles.inputs import as_triangles
+
+CUBE = np.array([[a, b, c] for a in (0.0, 1.0) for b in (0.0, 1.0) for c in (0.0, 1.0)])
+
+
+def _band(field):
+    coords, values, errors = field.band_values()
+    return field.grid.centers(coords), values, errors
+
+
+def _box_euclidean(p, lo, hi):
+    outside = np.linalg.norm(np.maximum(np.maximum(lo - p, p - hi), 0), axis=1)
+    inside = -np.min(np.minimum(p - lo, hi - p), axis=1)
+    return np.where(outside > 0, outside, inside)
+
+
+def _linf_ball_oracle(p, centre, r, weights):
+    """The weighted max-norm distance to a ball, by bisection on 'the cube meets the
+    ball' (clamp the centre into the cube): independent of the contact equations."""
+    lo, hi = np.zeros(len(p)), np.full(len(p), 10.0)
+    inside = np.linalg.norm(p - centre, axis=1) < r
+    for _ in range(80):
+        t = 0.5 * (lo + hi)
+        half = t[:, None] * weights
+        near = np.clip(centre, p - half, p + half)
+        meets = np.linalg.norm(near - centre, axis=1) <= r
+        far = np.linalg.norm(np.abs(p - centre) + half, axis=1) > r  # leaves the ball
+        hit = np.where(inside, far, meets)
+        lo, hi = np.where(hit, lo, t), np.where(hit, t, hi)
+    return np.where(inside, -hi, hi)
+
+
+EXACT_CASES = {
+    "sphere": (linf.Sphere((0.1, 0, 0), 0.8),
+               lambda p: np.linalg.norm(p - [0.1, 0, 0], axis=1) - 0.8),
+    "box": (linf.ConvexPolyhedron.from_points(CUBE * [1.0, 0.6, 0.4]),
+            lambda p: _box_euclidean(p, np.zeros(3), np.array([1.0, 0.6, 0.4]))),
+    "torus": (linf.Torus((0, 0, 0), (0, 0, 1), 0.7, 0.2),
+              lambda p: np.hypot(np.hypot(p[:, 0], p[:, 1]) - 0.7, p[:, 2]) - 0.2),
+    "cylinder": (linf.Cylinder((0, 0, -0.5), (0, 0, 1), 1.0, 0.4),
+                 # the (rho, z) rectangle [0, 0.4] x [-0.5, 0.5]; the axis is no boundary
+                 lambda p: _box_euclidean(np.c_[np.hypot(p[:, 0], p[:, 1]), p[:, 2],
+                                                np.zeros(len(p))],
+                                          np.array([-1.0, -0.5, -1.0]),
+                                          np.array([0.4, 0.5, 1.0]))),
+}
+
+
+@pytest.mark.parametrize("name", sorted(EXACT_CASES))
+def test_euclidean_fields_of_primitives_are_the_analytic_distances(name):
+    shape, truth = EXACT_CASES[name]
+    field = iv.distance_field(shape, 24, band=2)
+    p, v, e = _band(field)
+    assert field.kind == "exact" and field.count > 1000
+    assert np.allclose(v, truth(p), rtol=0, atol=1e-12)
+    assert field.max_error == 0.0
+
+
+def test_linf_field_of_a_sphere_matches_an_independent_oracle_on_non_cubic_voxels():
+    ball = linf.Sphere((0.05, 0, 0), 0.8)
+    field = iv.distance_field(ball, (20, 28, 36), norm="linf", band=2)
+    h = np.asarray(field.grid.voxel_size)
+    assert len(set(h.tolist())) == 3
+    p, v, _ = _band(field)
+    oracle = _linf_ball_oracle(p, ball.center, ball.r, h / h.max())
+    assert np.allclose(v, oracle, rtol=0, atol=1e-9)
+    # Varadhan §5.1: the surface meets a voxel iff |D(centre)| <= its longest half-edge
+    vox = iv.voxelize(ball, bounds=field.grid.bounds, voxel_size=field.grid.voxel_size)
+    c = field.coords()
+    meets = np.abs(v) <= h.max() / 2
+    assert np.array_equal(np.sort(iv.octree.morton.encode(c[meets])),
+                          np.sort(iv.octree.morton.encode(vox.coords())))
+
+
+def test_band_holds_every_sample_near_the_surface():
+    shape, truth = EXACT_CASES["torus"]
+    band = 3
+    field = iv.distance_field(shape, 32, band=band)
+    g = field.grid
+    ijk = np.stack(np.meshgrid(*[np.arange(n) for n in g.shape], indexing="ij"), -1).reshape(-1, 3)
+    near = np.abs(truth(g.centers(ijk))) <= (band + 0.5) * g.voxel_size[0]
+    stored = field.at(ijk)
+    assert np.allclose(stored[near], truth(g.centers(ijk[near])), atol=1e-12)
+    # beyond the band: the background with the right sign
+    far = np.abs(stored) == field.background
+    assert np.all(np.sign(stored[far]) == np.sign(truth(g.centers(ijk[far]))))
+
+
+def test_band_bricks_dilate_by_the_band_per_axis():
+    keys, active = band_bricks(np.array([[5, 9, 14]]), 2, (32, 32, 32))
+    coords = iv.fields.bricks.brick_coords(keys)[active]
+    assert len(coords) == 125
+    assert np.abs(coords - [5, 9, 14]).max() == 2
+
+
+def test_mesh_fields_equal_brute_force_over_every_triangle():
+    sphere = pv.Sphere(radius=1.0, theta_resolution=8, phi_resolution=8)
+    v, f = as_triangles(sphere)
+    tri = v[f]
+    for norm in ("euclidean", "linf"):
+        field = iv.distance_field((v, f), 16, norm=norm, band=2)
+        p, d, _ = _band(field)
+        rows = np.repeat(np.arange(len(p)), len(tri))
+        tiled = np.tile(tri, (len(p), 1, 1))
+        if norm == "euclidean":
+            brute = triangle_euclidean(p[rows], tiled)
+        else:
+            brute = linf.triangle_distance(p[rows], tiled)
+        brute = brute.reshape(len(p), -1).min(axis=1)
+        assert field.kind == "exact"
+        assert np.allclose(np.abs(d), brute, rtol=0, atol=1e-12)
+        inside = np.linalg.norm(p, axis=1) < 0.9
+        assert np.all(d[inside] < 0)
+
+
+@pytest.mark.parametrize("norm", ["euclidean", "linf"])
+def test_certified_distances_of_an_expression_hold_the_truth_within_1e3_voxel(norm):
+    # f = |p|^2 - 1 is not a distance: the field must certify one
+    field = iv.distance_field(x * x + y * y + z * z - 1, 20, band=1, norm=norm,
+                              bounds=((-1.3,) * 3, (1.3,) * 3))
+    p, v, e = _band(field)
+    truth = np.linalg.norm(p, axis=1) - 1 if norm == "euclidean" else \
+        linf.Sphere((0, 0, 0), 1.0).distance(p)
+    assert field.kind == "certified"
+    assert np.all(np.abs(v - truth) <= e * (1 + 1e-9) + 1e-15)
+    assert field.max_error <= 1e-3 * field.grid.voxel_size[0]
+
+
+def test_certified_torus_as_a_product_of_quadrics():
+    R, r = 0.6, 0.25
+    q = x * x + y * y + z * z + R * R - r * r
+    f = q * q - 4 * R * R * (x * x + y * y)           # the quartic: not a distance
+    field = iv.distance_field(f, 12, band=1, bounds=((-0.9, -0.9, -0.3), (0.9, 0.9, 0.3)))
+    p, v, e = _band(field)
+    truth = np.hypot(np.hypot(p[:, 0], p[:, 1]) - R, p[:, 2]) - r
+    assert np.all(np.abs(v - truth) <= e * (1 + 1e-9) + 1e-15)
+    assert field.max_error <= 1e-3 * field.grid.voxel_size[0]
+
+
+def test_linf_of_a_csg_union_by_the_box_test_is_the_min_outside():
+    box = csg.Box((1, 1, 1))
+    ball = csg.Sphere(r=0.6).translate((1.0, 0.5, 0.5))
+    union = box | ball
+    field = iv.distance_field(union, 20, norm="linf", band=2)
+    assert field.kind == "box test"
+    p, v, e = _band(field)
+    parts = np.minimum(box.linf_distance(p), ball.linf_distance(p))
+    out = parts > 0
+    assert np.allclose(v[out], parts[out], rtol=1e-12, atol=1e-15)
+    assert np.all(v[~out] <= 0) and e.max() <= 1e-12
+
+
+def test_box_test_bisection_finds_the_least_float():
+    ball = linf.Sphere((0, 0, 0), 1.0)
+    p = np.array([[1.5, 0.2, -0.1], [0.1, 0.2, 0.3]])
+    d, err = linf_by_box_test(ball.classify_boxes, p, None)
+    assert np.allclose(d, ball.distance(p), rtol=1e-14)
+    assert np.all(err <= np.spacing(np.abs(d)) * 2)
+
+
+def test_reconstruction_sample_gradient_and_isosurface():
+    ball = linf.Sphere((0.03, -0.02, 0.01), 0.8)
+    field = iv.distance_field(ball, 32, band=3, bounds=((-1.1,) * 3, (1.1,) * 3))
+    coords, values, _ = field.band_values()
+    assert np.array_equal(field.sample(field.grid.centers(coords[:50])), values[:50])
+    dirs = iv.fields.errors.fibonacci_directions(40)
+    on = ball.center + 0.8 * dirs
+    grad = field.gradient(on)
+    cos = np.sum(grad / np.linalg.norm(grad, axis=1, keepdims=True) * dirs, axis=1)
+    assert cos.min() > 0.99
+    mesh = field.isosurface()
+    radius = np.linalg.norm(np.asarray(mesh.points) - ball.center, axis=1)
+    h = field.grid.voxel_size[0]
+    assert np.abs(radius - 0.8).max() <= iv.fields.analytic_error_bound(0.8 / h) * h
+    assert mesh.n_cells > 1000 and mesh.point_data["Normals"].shape == (mesh.n_points, 3)
+
+
+def test_bærentzen_fig8_errors_fall_below_the_analytic_bound_and_0_1_voxel_from_r3():
+    for r in (2.0, 3.0, 5.0):
+        stats = iv.fields.sphere_reconstruction_errors(r, offsets=2, rays=150)
+        assert stats["max"] < iv.fields.analytic_error_bound(r)
+        if r >= 3:
+            assert stats["max"] < 0.1
+        assert 0 < stats["mean"] <= stats["max"]
+    assert iv.fields.analytic_error_bound(math.sqrt(3)) == math.inf
+    assert math.isclose(iv.fields.analytic_error_bound(3.0), 3 / (8 * (3 - math.sqrt(3))))
+
+
+def test_suitability_sphere_cube_and_two_close_spheres():
+    # a sphere of radius 10 voxels: open up to ~10 (a ball of radius 10 rolls inside),
+    # closed without limit (its complement is open for every ball): r ≈ 10, suitable
+    s = iv.suitability(linf.Sphere((0, 0, 0), 1.0), 21, oversample=2, max_radius=12)
+    assert 9 <= s.r_open <= 10.5 and s.r_closed == 12 and s.suitable
+    assert s.predicted_error == iv.fields.analytic_error_bound(s.r)
+    # a cube: no ball reaches into its corners, r = 0 up to the fine grid's voxel
+    cube = linf.ConvexPolyhedron.from_points(CUBE)
+    s = iv.suitability(cube, 16, oversample=4, max_radius=4)
+    assert s.r_open < 1 and not s.suitable
+    # two spheres 2 voxels apart: the gap closes for any ball wider than it, r ≈ 1
+    pitch = 4.0 / 31
+    pair = csg.Sphere(r=1.0) | csg.Sphere(r=1.0).translate((2 + 2 * pitch, 0, 0))
+    s = iv.suitability(pair, 32, oversample=2, max_radius=4)
+    assert 0.5 <= s.r_closed <= 1.5 and s.r_open > 3 and not s.suitable
+
+
+def test_files_round_trip_and_refuse_bad_input(tmp_path):
+    field = iv.distance_field(linf.Sphere((0, 0, 0), 1.0), 16, band=1)
+    back = iv.load_field(field.save(str(tmp_path / "f.npz")))
+    assert np.array_equal(back.values, field.values) and back.norm == field.norm
+    image = pv.read(field.save(str(tmp_path / "f.vti")))
+    assert image.n_points == int(np.prod(field.grid.shape))
+    bad = tmp_path / "bad.npz"
+    np.savez(bad, format=np.array([1]))
+    with pytest.raises(ValueError, match="field 'origin': missing"):
+        iv.load_field(str(bad))
+    with pytest.raises(ValueError, match="norm must be one of"):
+        iv.distance_field(linf.Sphere((0, 0, 0), 1.0), 8, norm="l2")
+    with pytest.raises(ValueError, match="band must be"):
+        iv.distance_field(linf.Sphere((0, 0, 0), 1.0), 8, band=0)
+    with pytest.raises(MemoryError, match="a distance field of .* bricks"):
+        # the voxelization fits in 80 MB (about 71 MB), its 8-voxel band does not
+        iv.distance_field(linf.Sphere((0, 0, 0), 1.0), 128, band=8, max_memory=80 << 20)
+
+
+def test_progress_is_monotone_and_ends_at_one():
+    seen = []
+    iv.distance_field(linf.Sphere((0, 0, 0), 1.0), 16, band=1, progress=seen.append)
+    assert seen == sorted(seen) and seen[-1] == 1.0
