@@ -317,9 +317,9 @@ def _pair_bounds(tape, nm: _Norm, p, w, lo, hi):
     gap = np.maximum(np.maximum(lo - p, p - hi), 0.0)
     to_box = nm.length(gap, w)
     # the slab of the box's zeros (mean value form)
-    g = 0.5 * (glo + ghi)
     half = 0.5 * (hi - lo)
     with np.errstate(all="ignore"):
+        g = 0.5 * (glo + ghi)
         spread = np.sum(0.5 * (ghi - glo) * half, axis=1)
         gc = np.einsum("ij,ij->i", g, c)
         s_lo = gc - chi - spread

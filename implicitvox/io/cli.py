@@ -8,6 +8,8 @@
     implicitvox voxelize bunny.obj --resolution 256 --interior --render bunny.png
     implicitvox voxelize bracket.csg --facets openscad --resolution 256 --out bracket.npz
     implicitvox mesh --example gear --tolerance 0.01 --out gear.stl --render gear.png
+    implicitvox field --example gear --resolution 256 --band 4 --out gear-sdf.vti
+    implicitvox field bunny.obj --norm linf --resolution 256 --check-suitability
 
 A model file is Python that defines ``shape`` (an expression or a shape);
 errors inside it are reported with the model's own file and line. OpenSCAD
@@ -16,7 +18,10 @@ file (``.stl``, ``.ply``, ``.obj``, ``.vtk``, ``.vtp``) is voxelized exactly
 (:func:`implicitvox.voxelize_mesh`; ``--interior`` fills closed meshes).
 ``mesh`` triangulates a model within a guaranteed Hausdorff distance
 (:func:`implicitvox.mesh`) and writes ``.stl``, ``.ply``, ``.obj``, ``.vtp`` or
-``.vtk``.
+``.vtk``. ``field`` samples the signed distance in a narrow band
+(:func:`implicitvox.distance_field`) and writes ``.npz`` or ``.vti``;
+``--check-suitability`` (on ``voxelize`` and ``field``) prints Bærentzen's
+criterion at the resolution (:func:`implicitvox.suitability`).
 """
 from __future__ import annotations
 
@@ -35,7 +40,10 @@ from ..octree.subdivide import RECHECK
 from ..voxelizers.implicit import voxelize
 from ..voxelizers.mesh import voxelize_mesh
 from ..meshing.mesher import REFINE, mesh
+from ..fields.sampled import distance_field
+from ..fields.suitability import suitability
 from .files import MESH_FORMATS, save_mesh
+from .field_files import FIELD_FORMATS
 from .rendering import render_mesh
 
 __all__ = ["main", "ProgressBar", "load_model"]
@@ -157,6 +165,28 @@ def _parser() -> argparse.ArgumentParser:
     vox.add_argument("--render", metavar="PNG", help="render a picture")
     vox.add_argument("--max-memory", type=float, metavar="GIB", help="refuse runs estimated above")
     vox.add_argument("--quiet", action="store_true", help="no progress bar")
+    vox.add_argument("--check-suitability", action="store_true",
+                     help="print whether the solid is S_r-open and closed with r > sqrt(6) "
+                          "voxels (Baerentzen's criterion) and the predicted error")
+    fld = sub.add_parser("field", help="signed distances in a narrow band, with their error")
+    fld.add_argument("model", nargs="?", help="a .py, .csg or .json model, or a mesh")
+    fld.add_argument("--example", help="a built-in example instead of a model file")
+    size = fld.add_mutually_exclusive_group()
+    size.add_argument("--resolution", type=int, help="voxels along the longest side (default 256)")
+    size.add_argument("--voxel-size", type=float, metavar="H", help="the voxels' edge length")
+    fld.add_argument("--bounds", type=float, nargs=6, metavar=("X0", "Y0", "Z0", "X1", "Y1", "Z1"))
+    fld.add_argument("--norm", choices=["euclidean", "linf"], default="euclidean")
+    fld.add_argument("--band", type=int, default=4, help="voxels around the surface (default 4)")
+    fld.add_argument("--tolerance", type=float, metavar="E",
+                     help="error target of certified distances (default 1e-3 voxel)")
+    fld.add_argument("--facets", choices=["true", "openscad"], default="true",
+                     help=".csg models: true curves, or OpenSCAD's own facets")
+    fld.add_argument("--out", help="write .npz (lossless) or .vti")
+    fld.add_argument("--render", metavar="PNG", help="render the 0-isosurface")
+    fld.add_argument("--check-suitability", action="store_true",
+                     help="print Baerentzen's suitability criterion at this resolution")
+    fld.add_argument("--max-memory", type=float, metavar="GIB", help="refuse runs estimated above")
+    fld.add_argument("--quiet", action="store_true", help="no progress bar")
     msh = sub.add_parser("mesh", help="triangulate a model within a guaranteed Hausdorff "
                                       "distance")
     msh.add_argument("model", nargs="?", help="a .py file that defines `shape`, or a .csg or "
@@ -234,6 +264,45 @@ def _mesh(args: argparse.Namespace) -> int:
     return 0
 
 
+def _suitability(shape: Any, args: argparse.Namespace, bounds: Any, max_memory: Any) -> None:
+    """Print Bærentzen's criterion for the model at the command's grid."""
+    if shape is None:
+        raise ModelError("--check-suitability needs an implicit or csg model (a mesh has no "
+                         "inside to open and close)")
+    answer = suitability(shape, args.resolution, bounds=bounds, voxel_size=args.voxel_size,
+                         max_memory=max_memory)
+    print(f"suitability: {answer}")
+
+
+def _field(args: argparse.Namespace) -> int:
+    is_mesh = args.model is not None and args.example is None and \
+        args.model.lower().endswith(MESH_SUFFIXES)
+    shape = args.model if is_mesh else _shape(args)
+    if args.out is not None and os.path.splitext(args.out)[1].lower() not in FIELD_FORMATS:
+        raise ModelError(f"--out {args.out}: a distance field is written as one of "
+                         f"{', '.join(FIELD_FORMATS)}")
+    bounds, max_memory = _common(args)
+    if args.check_suitability:
+        _suitability(None if is_mesh else shape, args, bounds, max_memory)
+    bar = None if args.quiet else ProgressBar("distances")
+    field = distance_field(shape, args.resolution, bounds=bounds, voxel_size=args.voxel_size,
+                           norm=args.norm, band=args.band, tolerance=args.tolerance,
+                           progress=bar, max_memory=max_memory)
+    if bar:
+        bar.close()
+    h = min(field.grid.voxel_size)
+    print(f"{field.count:,} samples ({field.norm}, {field.kind}) in a {field.band}-voxel band "
+          f"at {'x'.join(map(str, field.grid.shape))} in {field.metadata['seconds']:.2f} s; "
+          f"{len(field.keys):,} bricks, {field.nbytes:,} bytes; largest error "
+          f"{field.max_error:.3g} ({field.max_error / h:.2g} voxel)")
+    if args.out:
+        print(f"wrote {field.save(args.out)}")
+    if args.render:
+        name = args.example or os.path.basename(args.model)
+        print(f"rendered {render_mesh(field.isosurface(), args.render, title=name)}")
+    return 0
+
+
 def _voxelize(args: argparse.Namespace) -> int:
     is_mesh = args.model is not None and args.example is None and \
         args.model.lower().endswith(MESH_SUFFIXES)
@@ -242,6 +311,8 @@ def _voxelize(args: argparse.Namespace) -> int:
         raise ModelError(f"--out {args.out}: voxels are not triangles; write a mesh with "
                          "`implicitvox mesh MODEL --tolerance E --out X.stl`")
     bounds, max_memory = _common(args)
+    if args.check_suitability:
+        _suitability(shape, args, bounds, max_memory)
     bar = None if args.quiet else ProgressBar()
     if is_mesh:
         if args.normals or args.mean_value or args.subvoxel:
@@ -281,7 +352,7 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
             for name, (description, _) in EXAMPLES.items():
                 print(f"{name:<14}{description}")
             return 0
-        return _mesh(args) if args.command == "mesh" else _voxelize(args)
+        return {"mesh": _mesh, "field": _field, "voxelize": _voxelize}[args.command](args)
     except (ModelError, ValueError, TypeError, MemoryError, OSError) as err:
         if args.debug:
             traceback.print_exc()
