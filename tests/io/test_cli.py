@@ -159,3 +159,19 @@ def test_mesh_command_writes_a_mesh_and_voxelize_says_to_use_it(tmp_path, capsys
     assert main(["mesh", "--example", "sphere", "--resolution", "16", "--out",
                  str(tmp_path / "v.npz")]) == 2
     assert "a mesh is written as one of" in capsys.readouterr().err
+
+
+def test_field_command_writes_a_field_and_checks_suitability(tmp_path, capsys):
+    model = tmp_path / "ball.py"
+    model.write_text("from implicitvox import linf\nshape = linf.Sphere((0, 0, 0), 1.0)\n")
+    out = tmp_path / "ball.npz"
+    assert main(["field", str(model), "--resolution", "24", "--band", "2", "--out", str(out),
+                 "--check-suitability", "--quiet"]) == 0
+    text = capsys.readouterr().out
+    assert "suitability: S_r-open up to r = " in text and ": suitable" in text
+    assert "(euclidean, exact)" in text
+    back = ivx.load_field(str(out))
+    p = back.grid.centers(back.coords())
+    assert np.allclose(back.values[back.active], np.linalg.norm(p, axis=1) - 1, atol=1e-12)
+    assert main(["field", str(model), "--resolution", "8", "--out", "x.stl"]) == 2
+    assert "a distance field is written as one of .npz, .vti" in capsys.readouterr().err
