@@ -6,13 +6,14 @@
 * :mod:`.field` - ``DistanceField``: look-ups, trilinear reconstruction,
   gradients, the isosurface, dense outputs;
 * :mod:`.sampled` - ``distance_field``;
-* :mod:`.errors` - the analytic and empirical error bounds (Bærentzen §6);
+* :mod:`.bounds`, :mod:`.errors` - the analytic and empirical error bounds (Bærentzen §6);
 * :mod:`.suitability` - the S_r-open / S_r-closed criterion (Bærentzen §4-§5);
 * :mod:`.prefilter` - prefiltering, for comparison (Bærentzen §3.1).
 """
 from .field import DistanceField
 from .sampled import distance_field
-from .errors import analytic_error_bound, sphere_reconstruction_errors
+from .bounds import analytic_error_bound
+from .errors import sphere_reconstruction_errors
 from .suitability import Suitability, suitability
 from .prefilter import prefilter_comparison, prefiltered, prefiltered_samples
 

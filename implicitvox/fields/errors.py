@@ -22,35 +22,16 @@ True
 """
 from __future__ import annotations
 
-import math
-from typing import Any
-
 import numpy as np
 
 from .. import validate
 from ..linf.sphere import Sphere
+from .bounds import analytic_error_bound, fibonacci_directions
 from .sampled import distance_field
 
 __all__ = ["analytic_error_bound", "sphere_reconstruction_errors", "fibonacci_directions"]
 
 _BISECT = 48
-
-
-def analytic_error_bound(r: Any) -> Any:
-    """``3 / (8 (r - √3))`` voxels for ``r > √3`` (Bærentzen eq. 22), ``inf`` below."""
-    r = np.asarray(r, dtype=np.float64)
-    with np.errstate(divide="ignore"):
-        out = np.where(r > math.sqrt(3), 3.0 / (8.0 * (r - math.sqrt(3))), np.inf)
-    return out if out.ndim else float(out)
-
-
-def fibonacci_directions(count: int) -> np.ndarray:
-    """``count`` unit vectors spread evenly over the sphere."""
-    k = np.arange(count) + 0.5
-    z = 1 - 2 * k / count
-    angle = np.pi * (1 + 5 ** 0.5) * k
-    rho = np.sqrt(1 - z * z)
-    return np.stack([rho * np.cos(angle), rho * np.sin(angle), z], axis=1)
 
 
 def sphere_reconstruction_errors(radius: float, *, offsets: int = 8, rays: int = 500,
@@ -67,7 +48,8 @@ def sphere_reconstruction_errors(radius: float, *, offsets: int = 8, rays: int =
     for centre in rng.random((offsets, 3)):
         reach = radius + 3.0
         bounds = (tuple((centre - reach).tolist()), tuple((centre + reach).tolist()))
-        field = distance_field(Sphere(centre, radius), bounds=bounds, voxel_size=1.0, band=3)
+        field = distance_field(Sphere(centre, radius), bounds=bounds, voxel_size=1.0, band=3,
+                               check_suitability=False)
         lo = np.full(rays, max(radius - 1.5, 0.0))
         hi = np.full(rays, radius + 1.5)
         for _ in range(_BISECT):

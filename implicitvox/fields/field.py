@@ -63,11 +63,14 @@ class DistanceField:
         The band's samples.
     kind : str
         How the distances were found: ``"exact"``, ``"box test"`` or ``"certified"``.
+    signed : bool
+        False for an open mesh (unsigned distances, no inside).
     """
 
     def __init__(self, grid: Grid, norm: str, band: int, keys: np.ndarray, values: np.ndarray,
                  errors: np.ndarray, active: np.ndarray, kind: str,
-                 voxels: Optional[Voxels] = None, metadata: Optional[dict] = None):
+                 voxels: Optional[Voxels] = None, metadata: Optional[dict] = None,
+                 signed: bool = True):
         self.grid = grid
         self.norm = norm
         self.band = band
@@ -78,6 +81,7 @@ class DistanceField:
         self.kind = kind
         self.voxels = voxels
         self.metadata = metadata or {}
+        self.signed = signed
         self._index = BrickIndex(keys)
 
     # -- sizes ---------------------------------------------------------------------------

@@ -37,7 +37,7 @@ from ..eval.function import Function
 from ..expr.shape import as_shape
 from ..octree.grid import Grid, grid_of
 from ..octree.voxels import DEFAULT_DENSE_LIMIT
-from .errors import fibonacci_directions
+from .bounds import fibonacci_directions
 
 __all__ = ["bartlett_kernel", "prefiltered", "prefiltered_samples", "trilinear", "prefilter_comparison",
            "isosurface_offsets", "QUADRATURE"]
@@ -173,7 +173,8 @@ def prefilter_comparison(radii: Any = (2, 3, 4, 5, 6, 7, 8, 9), *, filter_radius
                 axis, centre = (0, 0, 1), np.array([c[0], c[1], 0.0])
             grid, values = prefiltered_samples(expr, bounds=bounds, voxel_size=1.0,
                                                radius=filter_radius)
-            field = distance_field(exact, bounds=bounds, voxel_size=1.0, band=3)
+            field = distance_field(exact, bounds=bounds, voxel_size=1.0, band=3,
+                                   check_suitability=False)
             level = 0.5
 
             def offset(sample, lvl):

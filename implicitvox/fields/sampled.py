@@ -36,6 +36,7 @@ from ..voxelizers.mesh import voxelize_mesh
 from .bricks import BRICK, MAX_BAND, band_bricks, brick_coords
 from .certified import certified_distances
 from .field import NORMS, DistanceField
+from .suitability import CRITICAL_RADIUS, SUITABILITY_CHECK_LIMIT, is_suitable_at, solid_voxels
 from .kernels import choose_kernel
 
 __all__ = ["distance_field", "TOLERANCE", "estimate_bytes"]
@@ -67,6 +68,7 @@ def distance_field(shape: Any, resolution: Union[int, tuple[int, int, int], None
                    bounds: Any = None,
                    voxel_size: Union[float, tuple[float, float, float], None] = None,
                    norm: str = "euclidean", band: int = 4, tolerance: Optional[float] = None,
+                   check_suitability: bool = True,
                    progress: Optional[Callable[[float], Any]] = None,
                    max_memory: Optional[int] = None) -> DistanceField:
     """Signed distances at the voxel centres within ``band`` voxels of the surface.
@@ -91,6 +93,12 @@ def distance_field(shape: Any, resolution: Union[int, tuple[int, int, int], None
     tolerance : float, optional
         The error target of certified distances, in world units; default
         ``1e-3`` of the shortest voxel edge. Exact kinds ignore it.
+    check_suitability : bool, default: True
+        Test Bærentzen's criterion (S_r-open and S_r-closed with ``r = √6``
+        voxels, :func:`implicitvox.fields.suitability.is_suitable_at`) on the
+        grid itself, and warn when it fails; grids over
+        :data:`~implicitvox.fields.suitability.SUITABILITY_CHECK_LIMIT` voxels and
+        meshes are not tested (``metadata["suitable"]`` is then None).
     progress : callable, optional
         Called with the share of the work done (0 to 1).
     max_memory : int, optional
@@ -105,7 +113,10 @@ def distance_field(shape: Any, resolution: Union[int, tuple[int, int, int], None
     -----
     UserWarning
         When a certified sample's error stays above the tolerance (detail the
-        refinement could not resolve).
+        refinement could not resolve), and when the solid is not suitable for
+        voxelization at the resolution (sharp edges, parts or gaps thinner than
+        about 5 voxels, curvature above 1/√6 per voxel): values and gradients
+        reconstructed near those places are off (Bærentzen §4-§6).
     """
     norm = validate.choice(norm, "norm", NORMS)
     band = validate.int_in(band, "band", 1, MAX_BAND)
@@ -151,6 +162,9 @@ def distance_field(shape: Any, resolution: Union[int, tuple[int, int, int], None
         values_band[part], errors_band[part] = kernel(grid.centers(coords[part]), weights)
         report(0.2 + 0.8 * min(1.0, (s + _CHUNK) / max(len(coords), 1)))
     field = _assemble(grid, norm, band, keys, active, values_band, errors_band, kernel.kind, vox)
+    field.signed = mesh is None or mesh.closed
+    field.metadata["suitable"] = _check_suitability(target, vox) if check_suitability and \
+        mesh is None else None
     if kernel.kind == "certified" and field.count and field.max_error > tol:
         worst = int(np.sum(errors_band > tol))
         warnings.warn(f"{worst:,} of {field.count:,} certified samples keep an error above the "
@@ -160,6 +174,25 @@ def distance_field(shape: Any, resolution: Union[int, tuple[int, int, int], None
                            "tolerance": tol, "bricks": len(keys)})
     report(1.0)
     return field
+
+
+def _check_suitability(shape, vox) -> Optional[bool]:
+    """Bærentzen's criterion at ``r = √6`` on the voxels' own grid (one opening and one
+    closing); a warning when it fails; None for grids too large to test."""
+    pad = int(math.ceil(CRITICAL_RADIUS)) + 2
+    cells = int(np.prod(np.asarray(vox.grid.shape) + 2 * pad, dtype=np.float64))
+    if cells > SUITABILITY_CHECK_LIMIT:
+        return None
+    solid = np.pad(solid_voxels(vox, shape), pad, constant_values=False)
+    if is_suitable_at(solid):
+        return True
+    warnings.warn(f"the solid is not suitable for voxelization at {vox.grid.shape} (Bærentzen "
+                  "§4-§5: not S_r-open and S_r-closed for r = √6 voxels): a sharp edge, a part "
+                  "or gap thinner than about 5 voxels, or curvature above 1/√6 per voxel; "
+                  "values and gradients reconstructed there are off. "
+                  "implicitvox.suitability(shape, resolution) measures r", UserWarning,
+                  stacklevel=3)
+    return False
 
 
 def _surface_boxes(vox) -> tuple[np.ndarray, np.ndarray]:

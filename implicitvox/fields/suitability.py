@@ -44,12 +44,15 @@ from ..expr.shape import as_shape
 from ..octree.budget import memory_budget, refuse_over_budget
 from ..octree.grid import grid_of
 from ..voxelizers.implicit import voxelize
-from .errors import analytic_error_bound
+from .bounds import analytic_error_bound
 
-__all__ = ["Suitability", "suitability", "CRITICAL_RADIUS"]
+__all__ = ["Suitability", "suitability", "CRITICAL_RADIUS", "solid_voxels", "is_suitable_at",
+           "SUITABILITY_CHECK_LIMIT"]
 
 #: Condition 2: no medial surface within √6 voxels of the boundary
 CRITICAL_RADIUS = math.sqrt(6)
+#: voxels of the largest grid :func:`implicitvox.distance_field` checks the criterion on
+SUITABILITY_CHECK_LIMIT = 1 << 25
 _STEPS = 8
 
 
@@ -128,10 +131,15 @@ def suitability(shape: Any, resolution: Any = None, *, bounds: Any = None,
 
 
 def _solid(shape, grid, max_memory) -> np.ndarray:
-    """Voxels of the solid on ``grid``: interior octants, and surface voxels whose
-    centre is inside (``f <= 0``)."""
     vox = voxelize(shape, bounds=grid.bounds, voxel_size=grid.voxel_size, interior=True,
                    max_memory=max_memory)
+    return solid_voxels(vox, shape)
+
+
+def solid_voxels(vox, shape) -> np.ndarray:
+    """The solid as a dense boolean array on the voxels' grid: interior octants, and
+    surface voxels whose centre is inside (``f <= 0``)."""
+    grid = vox.grid
     dense = vox.to_dense(interior=True)
     c = vox.coords()
     centres = grid.centers(c)
@@ -140,18 +148,33 @@ def _solid(shape, grid, max_memory) -> np.ndarray:
     return dense
 
 
+def is_suitable_at(solid: np.ndarray, rho: float = CRITICAL_RADIUS) -> bool:
+    """Whether the dense ``solid`` (padded by the caller where it reaches the array's
+    edge) is S_ρ-open and S_ρ-closed, ``ρ`` in its voxels (one test each, no bisection)."""
+    from scipy.ndimage import distance_transform_edt
+    return all(_opens(part, rho, distance_transform_edt) for part in (solid, ~solid))
+
+
+def _opens(solid: np.ndarray, rho: float, edt, depth: Optional[np.ndarray] = None) -> bool:
+    """Is ``solid`` unchanged by the opening with a ball of radius ``rho``?"""
+    if not solid.any():
+        return True
+    depth = edt(solid) if depth is None else depth   # distance to the nearest outside centre
+    centres = depth >= rho                            # a ball of radius rho fits
+    if not centres.any():
+        return False
+    reach = edt(~centres)
+    return not np.any(solid & (reach > rho + 1.0))
+
+
 def _largest_open(solid: np.ndarray, limit: float, edt) -> float:
     """The largest ``ρ <= limit`` (voxels) with ``solid`` S_ρ-open, by bisection."""
     if not solid.any():
         return limit
-    depth = edt(solid)                      # distance to the nearest outside voxel centre
+    depth = edt(solid)
 
     def is_open(rho: float) -> bool:
-        centres = depth >= rho              # a ball of radius rho fits
-        if not centres.any():
-            return False
-        reach = edt(~centres)
-        return not np.any(solid & (reach > rho + 1.0))
+        return _opens(solid, rho, edt, depth)
 
     if is_open(limit):
         return limit

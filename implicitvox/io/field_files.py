@@ -48,6 +48,7 @@ def save_field(field: DistanceField, path: str) -> str:
             voxel_size=np.array(field.grid.voxel_size), shape=np.array(field.grid.shape),
             norm=np.array(field.norm), band=np.array([field.band]), kind=np.array(field.kind),
             keys=field.keys, values=field.values, errors=field.errors, active=field.active,
+            signed=np.array([field.signed]),
             metadata=np.array(json.dumps(field.metadata, default=str)))
     return str(path)
 
@@ -76,7 +77,7 @@ def load_field(path: str) -> DistanceField:
             raise ValueError(f"{path!r} unpacks to {declared:,} bytes, over the limit of "
                              f"{NPZ_LIMIT:,} (implicitvox.io.files.NPZ_LIMIT)")
         need = ("format", "origin", "voxel_size", "shape", "norm", "band", "kind", "keys",
-                "values", "errors", "active")
+                "values", "errors", "active", "signed")
         for name in need:
             if name not in data.files:
                 raise bad(name, "missing")
@@ -116,5 +117,9 @@ def load_field(path: str) -> DistanceField:
     if np.any(~np.isfinite(arrays["values"][arrays["active"]])) or \
             np.any(~(arrays["errors"] >= 0)):
         raise bad("values", "band samples must be finite, errors non-negative")
+    signed = arrays["signed"]
+    if signed.shape != (1,) or signed.dtype != np.bool_:
+        raise bad("signed", "must be one bool")
     return DistanceField(grid, norm, int(band[0]), keys, arrays["values"], arrays["errors"],
-                         arrays["active"], kind, metadata=json.loads(meta) if meta else {})
+                         arrays["active"], kind, metadata=json.loads(meta) if meta else {},
+                         signed=bool(signed[0]))

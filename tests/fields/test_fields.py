@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import math
+import warnings
 
 import numpy as np
 import pytest
@@ -256,3 +257,15 @@ def test_prefiltered_isosurface_moves_with_curvature_and_the_distance_field_does
         assert scaled.max() / scaled.min() < 1.5
         # the sampled distance field's only error is reconstruction: several times smaller
         assert all(abs(r["distance_sampled"]) < abs(r["prefilter"]) / 2.5 for r in mine)
+
+
+def test_distance_field_warns_when_the_solid_is_unsuitable_at_the_resolution():
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        field = iv.distance_field(linf.Sphere((0, 0, 0), 1.0), 21, band=1)   # r = 10 voxels
+    assert field.metadata["suitable"] is True
+    with pytest.warns(UserWarning, match="not suitable for voxelization at"):
+        field = iv.distance_field(linf.ConvexPolyhedron.from_points(CUBE), 16, band=1)
+    assert field.metadata["suitable"] is False
+    with pytest.warns(UserWarning, match="not suitable"):                    # r = 2 voxels
+        iv.distance_field(linf.Sphere((0, 0, 0), 1.0), 5, band=1)
