@@ -246,34 +246,37 @@ def _bracket(tape, nm: _Norm, p, w, tree, boxes_lo, boxes_hi, half_diag, scale, 
     lo, hi = boxes_lo[box], boxes_hi[box]
     lower = np.where(counts == 0, reach, 0.0)     # no box within reach: nothing nearer
     state = {"upper": upper, "lower": lower, "open": counts > 0}
-    _refine(tape, nm, p, w, pt, lo, hi, 0, state, limit, tolerance, max_levels, stats)
+    _refine(tape, nm, p, w, pt, lo, hi, box.astype(np.int64), 0, state, limit, tolerance,
+            max_levels, stats)
     lower, upper = state["lower"], state["upper"]
     # outward: a relative margin, and one for the roundings of coordinates of this size
     slack = _MARGIN * (1.0 + float(np.max(np.abs(p))))
     return np.maximum(lower * (1 - _MARGIN) - slack, 0.0), upper
 
 
-def _refine(tape, nm, p, w, pt, lo, hi, level, state, limit, tolerance, max_levels, stats):
-    """Bound, prune and split the pairs ``(pt, box)`` level by level; where the children
+def _refine(tape, nm, p, w, pt, lo, hi, bid, level, state, limit, tolerance, max_levels,
+            stats):
+    """Bound, prune and split the pairs ``(pt, box)`` level by level (``bid`` names each
+    box: its surface voxel, then ``8 * parent + child``); where the children
     would exceed :data:`MAX_PAIRS`, the points are halved and each half refined on its
     own (a point's pairs stay together, so its bounds come from all of them)."""
     upper, lower, open_ = state["upper"], state["lower"], state["open"]
     while len(pt):
         mine = np.unique(pt)
-        lb, cand = _pair_bounds(tape, nm, p[pt], w[pt], lo, hi)
-        np.minimum.at(upper, pt, cand)
+        lb, cand_pt, cand = _pair_bounds(tape, nm, p, w, pt, lo, hi, bid)
+        np.minimum.at(upper, cand_pt, cand)
         reach = np.minimum(upper, limit)
         keep = np.isfinite(lb) & (lb <= reach[pt])
-        pt, lo, hi, lb = pt[keep], lo[keep], hi[keep], lb[keep]
+        pt, lo, hi, lb, bid = pt[keep], lo[keep], hi[keep], lb[keep], bid[keep]
         best = np.full(len(p), np.inf)
         np.minimum.at(best, pt, lb)
         lower[mine] = np.where(open_[mine], np.minimum(best[mine], reach[mine]), lower[mine])
         open_[mine] &= reach[mine] - lower[mine] > tolerance
         still = open_[pt]
-        pt, lo, hi = pt[still], lo[still], hi[still]
+        pt, lo, hi, bid = pt[still], lo[still], hi[still], bid[still]
         if level == max_levels or not len(pt):
             return
-        pt, lo, hi = _split(pt, lo, hi)
+        pt, lo, hi, bid = _split(pt, lo, hi, bid)
         level += 1
         stats["pairs"] += len(pt)
         if len(pt) > MAX_PAIRS:
@@ -282,40 +285,46 @@ def _refine(tape, nm, p, w, pt, lo, hi, level, state, limit, tolerance, max_leve
                 stats["capped"] += 1
                 return
             first = pt < points[len(points) // 2]
-            _refine(tape, nm, p, w, pt[first], lo[first], hi[first], level, state, limit,
-                    tolerance, max_levels, stats)
-            _refine(tape, nm, p, w, pt[~first], lo[~first], hi[~first], level, state, limit,
-                    tolerance, max_levels, stats)
+            _refine(tape, nm, p, w, pt[first], lo[first], hi[first], bid[first], level, state,
+                    limit, tolerance, max_levels, stats)
+            _refine(tape, nm, p, w, pt[~first], lo[~first], hi[~first], bid[~first], level,
+                    state, limit, tolerance, max_levels, stats)
             return
 
 
-def _split(pt, lo, hi):
-    """Each box into its 8 children (the pairs' point repeated)."""
+def _split(pt, lo, hi, bid):
+    """Each box into its 8 children (the pairs' point repeated), named ``8 * bid + k``."""
     mid = 0.5 * (lo + hi)
     corner = np.array(list(np.ndindex(2, 2, 2)), dtype=bool)          # (8, 3)
     clo = np.where(corner[None], mid[:, None], lo[:, None]).reshape(-1, 3)
     chi = np.where(corner[None], hi[:, None], mid[:, None]).reshape(-1, 3)
-    return np.repeat(pt, 8), clo, chi
+    children = (bid[:, None] * 8 + np.arange(8)[None]).reshape(-1)
+    return np.repeat(pt, 8), clo, chi, children
 
 
-def _pair_bounds(tape, nm: _Norm, p, w, lo, hi):
-    """Per (point, box) pair: a lower bound of the distance from the point to the
-    zeros of ``f`` in the box (``inf`` if the box has none), and an upper bound
-    from a certified zero near the box's plane (``inf`` if none was proved)."""
-    cols_lo, cols_hi = tuple(lo.T), tuple(hi.T)
+def _pair_bounds(tape, nm: _Norm, p, w, pt, lo, hi, bid):
+    """Per (point, box) pair: a lower bound of the distance from point ``pt`` to the
+    zeros of ``f`` in the box (``inf`` if the box has none). Boxes shared by several
+    points (same ``bid``) are evaluated once. Also ``(points, upper)``: for each point,
+    an upper bound from a certified zero near the plane of its most promising box
+    (``inf`` where none was proved)."""
+    boxes, first, which = np.unique(bid, return_index=True, return_inverse=True)
+    ulo, uhi = lo[first], hi[first]
     with np.errstate(all="ignore"):
-        vlo, vhi, glo, ghi, valid = evaluate_interval_gradients(tape, cols_lo, cols_hi)
-        c = 0.5 * (lo + hi)
-        ccols = tuple(c.T)
-        clo, chi = evaluate_intervals(tape, ccols, ccols)
-    m = len(lo)
-    vlo, vhi = np.broadcast_to(vlo, (m,)), np.broadcast_to(vhi, (m,))
-    clo, chi = np.broadcast_to(clo, (m,)), np.broadcast_to(chi, (m,))
-    glo = np.broadcast_to(glo, (3, m)).T
-    ghi = np.broadcast_to(ghi, (3, m)).T
+        vlo, vhi, glo, ghi, valid = evaluate_interval_gradients(tape, tuple(ulo.T), tuple(uhi.T))
+        uc = 0.5 * (ulo + uhi)
+        clo, chi = evaluate_intervals(tape, tuple(uc.T), tuple(uc.T))
+    k = len(boxes)
+    vlo, vhi = np.broadcast_to(vlo, (k,))[which], np.broadcast_to(vhi, (k,))[which]
+    clo, chi = np.broadcast_to(clo, (k,))[which], np.broadcast_to(chi, (k,))[which]
+    glo = np.broadcast_to(glo, (3, k)).T[which]
+    ghi = np.broadcast_to(ghi, (3, k)).T[which]
+    valid = np.broadcast_to(valid, (k,))[which]
+    c = uc[which]
+    q_pt, q_w = p[pt], w[pt]
     has_zero = (vlo <= 0) & (vhi >= 0)
-    gap = np.maximum(np.maximum(lo - p, p - hi), 0.0)
-    to_box = nm.length(gap, w)
+    gap = np.maximum(np.maximum(lo - q_pt, q_pt - hi), 0.0)
+    to_box = nm.length(gap, q_w)
     # the slab of the box's zeros (mean value form)
     half = 0.5 * (hi - lo)
     with np.errstate(all="ignore"):
@@ -324,26 +333,32 @@ def _pair_bounds(tape, nm: _Norm, p, w, lo, hi):
         gc = np.einsum("ij,ij->i", g, c)
         s_lo = gc - chi - spread
         s_hi = gc - clo + spread
-        gp = np.einsum("ij,ij->i", g, p)
-        dual = nm.dual(g, w)
+        gp = np.einsum("ij,ij->i", g, q_pt)
+        dual = nm.dual(g, q_w)
         to_slab = np.maximum(np.maximum(s_lo - gp, gp - s_hi), 0.0) / dual
         if nm.euclidean:
-            to_both = _euclidean_box_slab(p, c, half, g, to_slab)
+            to_both = _euclidean_box_slab(q_pt, c, half, g, to_slab)
         else:
-            to_both = _linf_box_slab(p, w, lo, hi, g, s_lo, s_hi)
+            to_both = _linf_box_slab(q_pt, q_w, lo, hi, g, s_lo, s_hi)
     slab_ok = valid & (dual > 0) & np.isfinite(to_slab) & (clo <= chi) & ~np.isnan(to_both)
     lb = np.where(slab_ok, np.maximum(to_box, to_both), to_box)
     lb = np.where(has_zero, lb, np.inf)
-    # a candidate zero: the point's nearest point on the slab's middle plane, in the box
-    direction = nm.step(g, w)
+    # a candidate zero for each point, from its box of least bound: the point's nearest
+    # point on the slab's middle plane, clipped to the box, then two Newton steps
+    order = np.lexsort((lb, pt))
+    lead = order[np.r_[True, pt[order][1:] != pt[order][:-1]]] if len(order) else order
+    lead = lead[has_zero[lead] & slab_ok[lead]]
+    r = lead
+    direction = nm.step(g[r], q_w[r])
     with np.errstate(all="ignore"):
-        q = p + (((s_lo + s_hi) / 2 - gp) / dual)[:, None] * direction
-    q = _newton(tape, np.clip(np.where(np.isfinite(q), q, c), lo, hi), steps=2)
-    unit = np.where(slab_ok[:, None], g / np.linalg.norm(g, axis=1, keepdims=True), 0.0)
+        q = q_pt[r] + (((s_lo[r] + s_hi[r]) / 2 - gp[r]) / dual[r])[:, None] * direction
+    q = _newton(tape, np.clip(np.where(np.isfinite(q), q, c[r]), lo[r], hi[r]), steps=2)
+    with np.errstate(all="ignore"):
+        unit = g[r] / np.linalg.norm(g[r], axis=1, keepdims=True)
     unit = np.where(np.isfinite(unit), unit, 0.0)
-    delta = np.maximum(np.max(half, axis=1) * 1e-4, 1e-12 * (1 + np.max(np.abs(c), axis=1)))
-    cand = np.where(has_zero & slab_ok, _certified_upper(tape, nm, p, w, q, unit, delta), np.inf)
-    return lb, cand
+    delta = np.maximum(np.max(half[r], axis=1) * 1e-4, 1e-12 * (1 + np.max(np.abs(c[r]), axis=1)))
+    upper = _certified_upper(tape, nm, q_pt[r], q_w[r], q, unit, delta)
+    return lb, pt[r], upper
 
 
 def _euclidean_box_slab(p, c, half, g, to_slab):
