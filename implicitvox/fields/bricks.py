@@ -29,7 +29,7 @@ import numpy as np
 
 from ..octree import morton
 
-__all__ = ["BRICK", "band_bricks", "brick_coords", "BrickIndex", "MAX_BAND"]
+__all__ = ["BRICK", "band_bricks", "all_bricks", "brick_coords", "BrickIndex", "MAX_BAND"]
 
 #: samples per brick edge
 BRICK = 8
@@ -85,6 +85,16 @@ def band_bricks(surface: np.ndarray, band: int, shape: tuple[int, int, int]
     coords = brick_coords(keys)
     inside = coords < np.asarray(shape)[None, None, None, None, :]
     return keys, active & np.all(inside, axis=-1)
+
+
+def all_bricks(shape: tuple[int, int, int]) -> tuple[np.ndarray, np.ndarray]:
+    """Every brick of a grid of ``shape``, every sample in the grid active (a field
+    everywhere)."""
+    counts = -(-np.asarray(shape) // BRICK)
+    idx = np.stack(np.meshgrid(*[np.arange(n) for n in counts], indexing="ij"), -1).reshape(-1, 3)
+    keys = np.sort(morton.encode(idx))
+    active = np.all(brick_coords(keys) < np.asarray(shape), axis=-1)
+    return keys, active
 
 
 def brick_coords(keys: np.ndarray) -> np.ndarray:

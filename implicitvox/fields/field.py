@@ -51,9 +51,9 @@ class DistanceField:
     norm : str
         ``"euclidean"`` or ``"linf"`` (the max-norm, weighted by the voxel
         size over its longest edge when voxels are not cubes).
-    band : int
+    band : int or None
         Every sample within ``band`` voxels (per axis) of a surface voxel is
-        computed.
+        computed; None: every sample of the grid.
     keys : ndarray of uint64 (k,)
         Sorted Morton codes of the bricks' indices.
     values, errors : ndarray (k, 8, 8, 8)
@@ -67,7 +67,8 @@ class DistanceField:
         False for an open mesh (unsigned distances, no inside).
     """
 
-    def __init__(self, grid: Grid, norm: str, band: int, keys: np.ndarray, values: np.ndarray,
+    def __init__(self, grid: Grid, norm: str, band: Optional[int], keys: np.ndarray,
+                 values: np.ndarray,
                  errors: np.ndarray, active: np.ndarray, kind: str,
                  voxels: Optional[Voxels] = None, metadata: Optional[dict] = None,
                  signed: bool = True):
@@ -87,8 +88,10 @@ class DistanceField:
     # -- sizes ---------------------------------------------------------------------------
     @property
     def background(self) -> float:
-        """The magnitude stored beyond the band: ``band + 1`` longest voxel edges."""
-        return (self.band + 1) * max(self.grid.voxel_size)
+        """The magnitude stored beyond the band: ``band + 1`` longest voxel edges (for a
+        field everywhere, the grid's longest side)."""
+        reach = max(self.grid.shape) if self.band is None else self.band + 1
+        return reach * max(self.grid.voxel_size)
 
     @property
     def count(self) -> int:
@@ -253,6 +256,7 @@ class DistanceField:
         return writer(self, path)
 
     def __repr__(self) -> str:
-        return (f"<DistanceField {self.norm}, {self.count:,} samples in a {self.band}-voxel "
-                f"band, {len(self.keys):,} bricks of {BRICK}³, grid {self.grid.shape}, "
+        where = "everywhere" if self.band is None else f"in a {self.band}-voxel band"
+        return (f"<DistanceField {self.norm}, {self.count:,} samples {where}, "
+                f"{len(self.keys):,} bricks of {BRICK}³, grid {self.grid.shape}, "
                 f"{self.kind}, max error {self.max_error:.3g}>")

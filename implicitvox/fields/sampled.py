@@ -33,7 +33,7 @@ from ..octree.grid import grid_of
 from ..triangles.inputs import as_triangles
 from ..voxelizers.implicit import voxelize
 from ..voxelizers.mesh import voxelize_mesh
-from .bricks import BRICK, MAX_BAND, band_bricks, brick_coords
+from .bricks import BRICK, MAX_BAND, all_bricks, band_bricks, brick_coords
 from .certified import certified_distances
 from .field import NORMS, DistanceField
 from .suitability import CRITICAL_RADIUS, SUITABILITY_CHECK_LIMIT, is_suitable_at, solid_voxels
@@ -67,7 +67,8 @@ def _as_mesh(shape: Any) -> Optional[TriangleMesh]:
 def distance_field(shape: Any, resolution: Union[int, tuple[int, int, int], None] = None, *,
                    bounds: Any = None,
                    voxel_size: Union[float, tuple[float, float, float], None] = None,
-                   norm: str = "euclidean", band: int = 4, tolerance: Optional[float] = None,
+                   norm: str = "euclidean", band: Optional[int] = 4,
+                   tolerance: Optional[float] = None,
                    check_suitability: bool = True,
                    progress: Optional[Callable[[float], Any]] = None,
                    max_memory: Optional[int] = None) -> DistanceField:
@@ -87,9 +88,10 @@ def distance_field(shape: Any, resolution: Union[int, tuple[int, int, int], None
         The Euclidean distance, or the max-norm of Varadhan et al. (weighted by
         the voxel size over its longest edge when voxels are not cubes, so that
         the surface meets a voxel iff ``|d(centre)| <= longest edge / 2``).
-    band : int, default: 4
+    band : int or None, default: 4
         Samples within this many voxels (per axis) of a surface voxel are
-        computed (1 to 64); the rest hold ``±(band + 1)`` voxels.
+        computed (1 to 64); the rest hold ``±(band + 1)`` voxels. None: every
+        sample of the grid.
     tolerance : float, optional
         The error target of certified distances, in world units; default
         ``1e-3`` of the shortest voxel edge. Exact kinds ignore it.
@@ -119,7 +121,7 @@ def distance_field(shape: Any, resolution: Union[int, tuple[int, int, int], None
         reconstructed near those places are off (Bærentzen §4-§6).
     """
     norm = validate.choice(norm, "norm", NORMS)
-    band = validate.int_in(band, "band", 1, MAX_BAND)
+    band = None if band is None else validate.int_in(band, "band", 1, MAX_BAND)
     budget = memory_budget(max_memory)
     report = progress if progress is not None else (lambda share: None)
     mesh = _as_mesh(shape)
@@ -140,10 +142,12 @@ def distance_field(shape: Any, resolution: Union[int, tuple[int, int, int], None
         validate.positive_number(tolerance, "tolerance")
     weights = h / h.max()
     surface = vox.coords()
-    keys, active = band_bricks(surface, band, grid.shape)
+    keys, active = band_bricks(surface, band, grid.shape) if band is not None else \
+        all_bricks(grid.shape)
     refuse_over_budget(estimate_bytes(len(keys)), budget,
                        f"a distance field of {len(keys):,} bricks at {grid.shape}")
-    limit = (band + 1) * float(h.max()) * (math.sqrt(3) if norm == "euclidean" else 1.0)
+    reach = max(grid.shape) if band is None else band + 1
+    limit = reach * float(h.max()) * (math.sqrt(3) if norm == "euclidean" else 1.0)
 
     compiled: list = []          # the function and the surface boxes, built on first use
 
@@ -204,9 +208,9 @@ def _surface_boxes(vox) -> tuple[np.ndarray, np.ndarray]:
 def _assemble(grid, norm, band, keys, active, values_band, errors_band, kind, vox
               ) -> DistanceField:
     """The bricks: band samples from the kernel, the rest the signed background."""
-    background = (band + 1) * max(grid.voxel_size)
     field = DistanceField(grid, norm, band, keys, np.zeros(active.shape), np.zeros(active.shape),
                           active, kind, voxels=vox)
+    background = field.background
     field.values[active] = values_band
     field.errors[active] = errors_band
     rest = ~active

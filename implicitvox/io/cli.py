@@ -176,7 +176,8 @@ def _parser() -> argparse.ArgumentParser:
     size.add_argument("--voxel-size", type=float, metavar="H", help="the voxels' edge length")
     fld.add_argument("--bounds", type=float, nargs=6, metavar=("X0", "Y0", "Z0", "X1", "Y1", "Z1"))
     fld.add_argument("--norm", choices=["euclidean", "linf"], default="euclidean")
-    fld.add_argument("--band", type=int, default=4, help="voxels around the surface (default 4)")
+    fld.add_argument("--band", type=int, default=4,
+                     help="voxels around the surface (default 4; 0: every voxel)")
     fld.add_argument("--tolerance", type=float, metavar="E",
                      help="error target of certified distances (default 1e-3 voxel)")
     fld.add_argument("--facets", choices=["true", "openscad"], default="true",
@@ -286,12 +287,13 @@ def _field(args: argparse.Namespace) -> int:
         _suitability(None if is_mesh else shape, args, bounds, max_memory)
     bar = None if args.quiet else ProgressBar("distances")
     field = distance_field(shape, args.resolution, bounds=bounds, voxel_size=args.voxel_size,
-                           norm=args.norm, band=args.band, tolerance=args.tolerance,
+                           norm=args.norm, band=args.band or None, tolerance=args.tolerance,
                            progress=bar, max_memory=max_memory)
     if bar:
         bar.close()
     h = min(field.grid.voxel_size)
-    print(f"{field.count:,} samples ({field.norm}, {field.kind}) in a {field.band}-voxel band "
+    where = "everywhere" if field.band is None else f"in a {field.band}-voxel band"
+    print(f"{field.count:,} samples ({field.norm}, {field.kind}) {where} "
           f"at {'x'.join(map(str, field.grid.shape))} in {field.metadata['seconds']:.2f} s; "
           f"{len(field.keys):,} bricks, {field.nbytes:,} bytes; largest error "
           f"{field.max_error:.3g} ({field.max_error / h:.2g} voxel)")

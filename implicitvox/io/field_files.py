@@ -46,7 +46,7 @@ def save_field(field: DistanceField, path: str) -> str:
         np.savez_compressed(
             fh, format=np.array([_VERSION]), origin=np.array(field.grid.origin),
             voxel_size=np.array(field.grid.voxel_size), shape=np.array(field.grid.shape),
-            norm=np.array(field.norm), band=np.array([field.band]), kind=np.array(field.kind),
+            norm=np.array(field.norm), band=np.array([field.band or 0]), kind=np.array(field.kind),
             keys=field.keys, values=field.values, errors=field.errors, active=field.active,
             signed=np.array([field.signed]),
             metadata=np.array(json.dumps(field.metadata, default=str)))
@@ -100,8 +100,8 @@ def load_field(path: str) -> DistanceField:
     if kind not in _KINDS:
         raise bad("kind", f"must be one of {_KINDS}, got {kind!r}")
     band = arrays["band"]
-    if band.shape != (1,) or band.dtype.kind not in "iu" or not 1 <= int(band[0]) <= MAX_BAND:
-        raise bad("band", f"must be one count from 1 to {MAX_BAND}")
+    if band.shape != (1,) or band.dtype.kind not in "iu" or not 0 <= int(band[0]) <= MAX_BAND:
+        raise bad("band", f"must be one count from 0 (everywhere) to {MAX_BAND}")
     keys = arrays["keys"]
     if keys.dtype != np.uint64 or keys.ndim != 1 or np.any(keys[1:] <= keys[:-1]):
         raise bad("keys", "must be strictly increasing uint64 Morton codes")
@@ -120,6 +120,6 @@ def load_field(path: str) -> DistanceField:
     signed = arrays["signed"]
     if signed.shape != (1,) or signed.dtype != np.bool_:
         raise bad("signed", "must be one bool")
-    return DistanceField(grid, norm, int(band[0]), keys, arrays["values"], arrays["errors"],
+    return DistanceField(grid, norm, int(band[0]) or None, keys, arrays["values"], arrays["errors"],
                          arrays["active"], kind, metadata=json.loads(meta) if meta else {},
                          signed=bool(signed[0]))

@@ -269,3 +269,12 @@ def test_distance_field_warns_when_the_solid_is_unsuitable_at_the_resolution():
     assert field.metadata["suitable"] is False
     with pytest.warns(UserWarning, match="not suitable"):                    # r = 2 voxels
         iv.distance_field(linf.Sphere((0, 0, 0), 1.0), 5, band=1)
+
+
+def test_a_field_everywhere_holds_every_sample():
+    shape, truth = EXACT_CASES["sphere"]
+    field = iv.distance_field(shape, 12, band=None)
+    g = field.grid
+    assert field.count == int(np.prod(g.shape)) and field.band is None
+    p, v, _ = _band(field)
+    assert np.allclose(v, truth(p), atol=1e-12)
