@@ -331,13 +331,16 @@ def _pair_bounds(tape, nm: _Norm, p, w, pt, lo, hi, bid):
         g = 0.5 * (glo + ghi)
         spread = np.sum(0.5 * (ghi - glo) * half, axis=1)
         gc = np.einsum("ij,ij->i", g, c)
-        s_lo = gc - chi - spread
-        s_hi = gc - clo + spread
+        # widened by the roundings of these few operations (each relative 2**-53)
+        slack = 8 * np.finfo(np.float64).eps * (np.abs(gc) + np.maximum(np.abs(clo), np.abs(chi))
+                                                + spread)
+        s_lo = gc - chi - spread - slack
+        s_hi = gc - clo + spread + slack
         gp = np.einsum("ij,ij->i", g, q_pt)
         dual = nm.dual(g, q_w)
         to_slab = np.maximum(np.maximum(s_lo - gp, gp - s_hi), 0.0) / dual
         if nm.euclidean:
-            to_both = _euclidean_box_slab(q_pt, c, half, g, to_slab)
+            to_both = _euclidean_box_slab(q_pt, lo, hi, g, s_lo, s_hi, to_slab)
         else:
             to_both = _linf_box_slab(q_pt, q_w, lo, hi, g, s_lo, s_hi)
     slab_ok = valid & (dual > 0) & np.isfinite(to_slab) & (clo <= chi) & ~np.isnan(to_both)
@@ -361,18 +364,51 @@ def _pair_bounds(tape, nm: _Norm, p, w, pt, lo, hi, bid):
     return lb, pt[r], upper
 
 
-def _euclidean_box_slab(p, c, half, g, to_slab):
+_CORNERS = np.array(list(np.ndindex(2, 2, 2)), dtype=bool)                    # (8, 3)
+_EDGES = np.array([(i, j) for i in range(8) for j in range(i + 1, 8)
+                   if np.sum(_CORNERS[i] != _CORNERS[j]) == 1])                  # (12, 2)
+
+
+def _euclidean_box_slab(p, lo, hi, g, s_lo, s_hi, to_slab):
     """A lower bound of the Euclidean distance from ``p`` to (box ∩ slab): with ``n``
-    the slab's normal, ``q - p = a n + v`` (``v ⊥ n``), ``|a| >= to_slab``, and
-    along the unit ``t`` of ``p - c`` projected off ``n``, ``t·v <= h_box(t) - |P(p - c)|``
-    (``h_box`` the box's support), so ``|v|`` is at least the excess."""
+    the slab's normal, ``q - p = a n + v`` (``v ⊥ n``) with ``|a| >= to_slab``, and
+    along the unit ``t`` of ``p`` less the box centre, projected off ``n``,
+    ``|v| >= t·p - max_q t·q`` over the polytope. That maximum lies at a vertex of
+    box ∩ slab: a box corner inside the slab, or where a box edge crosses one of
+    the slab's planes. ``inf`` where box ∩ slab is empty (no zero in the box).
+    Written on (pairs, 8 corners) and (pairs, 12 edges) arrays: a corner's value of
+    a linear function is its value at ``lo`` plus the steps of its high axes."""
     n = g / np.linalg.norm(g, axis=1, keepdims=True)
-    d = p - c
-    lateral = d - np.einsum("ij,ij->i", d, n)[:, None] * n
+    step = hi - lo
+    bits = _CORNERS.astype(np.float64)                                       # (8, 3)
+    level = np.einsum("ij,ij->i", g, lo)[:, None] + (g * step) @ bits.T      # g·corner
+    inside = (level >= s_lo[:, None]) & (level <= s_hi[:, None])
+    a, b = _EDGES[:, 0], _EDGES[:, 1]
+    la, lb = level[:, a], level[:, b]                                        # (m, 12)
+    d = p - 0.5 * (lo + hi)
+    along = np.einsum("ij,ij->i", d, n)
+    lateral = d - along[:, None] * n
+    lateral -= np.einsum("ij,ij->i", lateral, n)[:, None] * n          # once more: ⊥ n
     length = np.linalg.norm(lateral, axis=1)
-    t = lateral / np.where(length > 0, length, 1.0)[:, None]
-    excess = np.maximum(length - np.sum(np.abs(t) * half, axis=1), 0.0)
-    return np.sqrt(to_slab * to_slab + excess * excess)
+    size = np.linalg.norm(step, axis=1)
+    # a direction within rounding of n would count the normal distance twice: none then
+    usable = length > 1e-9 * (np.abs(along) + size)
+    t = lateral / np.where(usable, length, 1.0)[:, None]
+    value = np.einsum("ij,ij->i", t, lo)[:, None] + (t * step) @ bits.T      # t·corner
+    va, vb = value[:, a], value[:, b]
+    reach = np.max(np.where(inside, value, -np.inf), axis=1)
+    feasible = inside.any(axis=1)
+    for s in (s_lo, s_hi):
+        with np.errstate(invalid="ignore", divide="ignore"):
+            tau = (s[:, None] - la) / (lb - la)
+        hit = (tau >= 0) & (tau <= 1)
+        reach = np.maximum(reach, np.max(np.where(hit, va + tau * (vb - va), -np.inf), axis=1))
+        feasible |= hit.any(axis=1)
+    # what t's rounding off the plane (|t.n|) could add along n, over the polytope
+    leak = np.abs(np.einsum("ij,ij->i", t, n)) * (np.abs(along) + size)
+    excess = np.maximum(np.einsum("ij,ij->i", t, p) - reach - leak, 0.0)
+    excess = np.where(usable, excess, 0.0)
+    return np.where(feasible, np.sqrt(to_slab * to_slab + excess * excess), np.inf)
 
 
 def _first_reach(start: np.ndarray, slope: np.ndarray, stop: np.ndarray, target: np.ndarray

@@ -278,3 +278,29 @@ def test_a_field_everywhere_holds_every_sample():
     assert field.count == int(np.prod(g.shape)) and field.band is None
     p, v, _ = _band(field)
     assert np.allclose(v, truth(p), atol=1e-12)
+
+
+def test_box_slab_lower_bounds_never_exceed_the_distance_to_box_and_slab():
+    # the bounds the certified search prunes with, against dense samples of box ∩ slab,
+    # including points on the slab's normal through the box (a direction of rounding)
+    from implicitvox.fields.certified import _euclidean_box_slab, _linf_box_slab
+    rng = np.random.default_rng(3)
+    for trial in range(300):
+        lo = rng.uniform(-1, 0, (1, 3))
+        hi = lo + rng.uniform(0.05, 1, (1, 3))
+        g = rng.normal(size=(1, 3)) if trial % 3 else np.full((1, 3), rng.uniform(0.5, 2))
+        mid = float(g[0] @ (0.5 * (lo + hi))[0])
+        s_lo = np.array([mid + rng.uniform(-0.3, 0.1)])
+        s_hi = s_lo + rng.uniform(0, 0.2)
+        n = g[0] / np.linalg.norm(g[0])
+        p = (0.5 * (lo + hi)) + rng.uniform(-2, 2) * n if trial % 2 else rng.uniform(-3, 3, (1, 3))
+        gp = float(g[0] @ p[0])
+        to_slab = np.array([max(s_lo[0] - gp, gp - s_hi[0], 0.0) / np.linalg.norm(g)])
+        q = rng.uniform(lo[0], hi[0], (40000, 3))
+        q = q[(q @ g[0] >= s_lo[0]) & (q @ g[0] <= s_hi[0])]
+        if not len(q):
+            continue
+        euclid = _euclidean_box_slab(p, lo, hi, g, s_lo, s_hi, to_slab)[0]
+        assert euclid <= np.linalg.norm(q - p, axis=1).min() + 1e-12
+        cheb = _linf_box_slab(p, np.ones((1, 3)), lo, hi, g, s_lo, s_hi)[0]
+        assert cheb <= np.abs(q - p).max(axis=1).min() + 1e-12
