@@ -275,9 +275,14 @@ def _suitability(shape: Any, args: argparse.Namespace, bounds: Any, max_memory: 
     print(f"suitability: {answer}")
 
 
-def _field(args: argparse.Namespace) -> int:
-    is_mesh = args.model is not None and args.example is None and \
+def _is_mesh(args: argparse.Namespace) -> bool:
+    """Whether the command's model is a triangle mesh file."""
+    return args.model is not None and args.example is None and \
         args.model.lower().endswith(MESH_SUFFIXES)
+
+
+def _field(args: argparse.Namespace) -> int:
+    is_mesh = _is_mesh(args)
     shape = args.model if is_mesh else _shape(args)
     if args.out is not None and os.path.splitext(args.out)[1].lower() not in FIELD_FORMATS:
         raise ModelError(f"--out {args.out}: a distance field is written as one of "
@@ -306,8 +311,7 @@ def _field(args: argparse.Namespace) -> int:
 
 
 def _voxelize(args: argparse.Namespace) -> int:
-    is_mesh = args.model is not None and args.example is None and \
-        args.model.lower().endswith(MESH_SUFFIXES)
+    is_mesh = _is_mesh(args)
     shape = None if is_mesh else _shape(args)
     if args.out is not None and os.path.splitext(args.out)[1].lower() in MESH_FORMATS:
         raise ModelError(f"--out {args.out}: voxels are not triangles; write a mesh with "

@@ -27,7 +27,6 @@ import argparse
 import json
 import os
 import resource
-import subprocess
 import sys
 import time
 
@@ -117,15 +116,6 @@ def _cache(name: str, res: int) -> str:
     return os.path.join(os.environ.get("TMPDIR", "/tmp"), f"implicitvox-bench-{name}-{res}.npz")
 
 
-def _run_child(name: str, res: int, method: str) -> dict:
-    cmd = [sys.executable, __file__, "--child", name, str(res), method]
-    done = subprocess.run(cmd, capture_output=True, text=True)
-    if done.returncode != 0:
-        tail = (done.stderr.strip().splitlines() or ["?"])[-1]
-        return {"error_text": tail[:160]}
-    return json.loads(done.stdout.strip().splitlines()[-1])
-
-
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--cases", nargs="+", default=list(CASES), choices=list(CASES))
@@ -143,7 +133,7 @@ def main() -> None:
         res, norm, band = CASES[name]
         res = QUICK[name] if args.quick else res
         for method in ("field", "baseline"):
-            r = _run_child(name, res, method)
+            r = tables.run_child(__file__, name, str(res), method)
             what = ("implicitvox " + r.get("kind", "")) if method == "field" else \
                 ("scipy distance_transform_cdt" if name == "bunny-linf" else
                  "scipy distance_transform_edt")

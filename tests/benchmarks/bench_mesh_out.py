@@ -28,7 +28,6 @@ import json
 import math
 import os
 import resource
-import subprocess
 import sys
 import time
 
@@ -101,15 +100,6 @@ def child(name: str, res: int, method: str) -> dict:
     return out
 
 
-def _run_child(name: str, res: int, method: str) -> dict:
-    cmd = [sys.executable, __file__, "--child", name, str(res), method]
-    done = subprocess.run(cmd, capture_output=True, text=True)
-    if done.returncode != 0:
-        tail = (done.stderr.strip().splitlines() or ["?"])[-1]
-        return {"error": tail[:120]}
-    return json.loads(done.stdout.strip().splitlines()[-1])
-
-
 def _fmt(r: dict, key: str, spec: str) -> str:
     return "-" if key not in r else format(r[key], spec)
 
@@ -144,13 +134,14 @@ def main() -> None:
                     shape = _shape(name)
                     _, need = estimate_mesh_memory(shape, grid_of(shape.bounds, None, res, None))
                     r = {"error": f"not run: estimated {need / 2**30:.1f} GiB"} \
-                        if need > args.mesh_limit * 2**30 else _run_child(name, res, method)
+                        if need > args.mesh_limit * 2**30 else \
+                        tables.run_child(__file__, name, str(res), method)
                 else:
-                    r = _run_child(name, res, method)
+                    r = tables.run_child(__file__, name, str(res), method)
                 row = [name, res, method, _fmt(r, "seconds", ".2f"), _fmt(r, "triangles", ","),
                        "-" if "peak" not in r else f"{r['peak'] / 2**20:,.0f}",
                        _fmt(r, "there", ".3f"), _fmt(r, "back", ".3f"),
-                       _fmt(r, "uncertified", ","), r.get("error", "")]
+                       _fmt(r, "uncertified", ","), r.get("error", r.get("error_text", ""))]
                 print(" | ".join(str(c) for c in row), flush=True)
                 rows.append(row)
     header = ["model", "N", "method", "seconds", "triangles", "peak MiB",

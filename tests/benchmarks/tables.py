@@ -62,6 +62,20 @@ def write(name: str, header: Sequence[str], rows: Sequence[Sequence[str]], comma
     return path
 
 
+def run_child(script: str, *args: str) -> dict:
+    """Run ``python script --child ARGS`` (a benchmark case in a fresh process, so its
+    peak memory is its own): the JSON of its last line, or ``{"error_text": ...}``."""
+    import json
+    import subprocess
+    import sys
+    done = subprocess.run([sys.executable, script, "--child", *args], capture_output=True,
+                          text=True)
+    if done.returncode != 0:
+        tail = (done.stderr.strip().splitlines() or ["?"])[-1]
+        return {"error_text": tail[:160]}
+    return json.loads(done.stdout.strip().splitlines()[-1])
+
+
 def tables() -> dict[str, str]:
     """The committed results files, by name."""
     return {p.stem: p.read_text() for p in sorted(RESULTS.glob("*.md"))}
