@@ -22,5 +22,14 @@ def test_gallery_script_runs(script, tmp_path):
     assert list(tmp_path.glob("*.png")), "the script wrote no picture"
 
 
-def test_gallery_has_scripts():
+def test_gallery_has_scripts_that_import_the_package_plainly():
     assert len(SCRIPTS) >= 2
+    for script in SCRIPTS:
+        assert "sys.path" not in script.read_text(), f"{script.name} edits sys.path"
+
+
+def test_the_gallery_command_names_its_folders_and_refuses_unknown_ones(capsys):
+    from implicitvox import gallery
+    assert {p.parent.name for p in gallery.scripts()} >= {"01-surfaces", "06-fields"}
+    with pytest.raises(ValueError, match="no gallery folder"):
+        gallery.scripts(["no-such-folder"])

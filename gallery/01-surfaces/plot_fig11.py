@@ -9,15 +9,11 @@ voxel, as Stolte shows them) and as a mesh within a guaranteed Hausdorff distanc
 (``implicitvox.mesh``). (a) to (c) are in ``plot_sinsin.py`` and ``plot_gear.py``.
 """
 # %%
-import sys
-from pathlib import Path
+from implicitvox.gallery import RESOLUTION, out
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-from common import RESOLUTION, out  # noqa: E402
-
-import implicitvox as iv  # noqa: E402
-from implicitvox.expr.examples import blobby, lobed_plate, sinsin  # noqa: E402
-from implicitvox.io.rendering import render_mesh  # noqa: E402
+import implicitvox as iv
+from implicitvox.expr.examples import blobby, lobed_plate, sinsin
+from implicitvox.io.rendering import render_mesh
 
 # %%
 scenes = {"fig11d-lobed-plate": ("rho - (1.2 + 0.05 sin 3 theta), a plate", lobed_plate()),

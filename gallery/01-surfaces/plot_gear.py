@@ -6,13 +6,9 @@ Stolte's Fig. 11-c: teeth ``rho - (0.8 + 0.05 sin(32 theta))`` cut to a slab,
 with a hub and a bore (CSG by min/max).
 """
 # %%
-import sys
-from pathlib import Path
+from implicitvox.gallery import RESOLUTION, out
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-from common import RESOLUTION, out  # noqa: E402
-
-import implicitvox as iv  # noqa: E402
+import implicitvox as iv
 from implicitvox.expr.examples import gear
 
 # %%

@@ -9,13 +9,11 @@ redistributed); without it, PyVista's bundled nut stands in.
 """
 # %%
 import os
-import sys
 from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-from common import RESOLUTION, out  # noqa: E402
+from implicitvox.gallery import RESOLUTION, out
 
-import implicitvox as iv  # noqa: E402
+import implicitvox as iv
 
 # %%
 bunny = Path(os.environ.get("IMPLICITVOX_BUNNY", Path(__file__).resolve().parents[3] /

@@ -6,13 +6,9 @@ Newell's bicubic patches, voxelized by De Casteljau subdivision with a
 flatness stop (Stolte §4.2): every voxel a patch meets is output.
 """
 # %%
-import sys
-from pathlib import Path
+from implicitvox.gallery import RESOLUTION, out
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-from common import RESOLUTION, out  # noqa: E402
-
-import implicitvox as iv  # noqa: E402
+import implicitvox as iv
 
 # %%
 vox = iv.voxelize_bezier(iv.utah_teapot(), RESOLUTION)

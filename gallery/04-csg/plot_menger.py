@@ -9,14 +9,10 @@ any voxel a few dozen of the 646 instructions remain, and the voxels are the sam
 bit for bit, as with the whole expression (``prune=False``).
 """
 # %%
-import sys
-from pathlib import Path
+from implicitvox.gallery import RESOLUTION, out
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-from common import RESOLUTION, out  # noqa: E402
-
-import implicitvox as iv  # noqa: E402
-from implicitvox.expr.examples import menger  # noqa: E402
+import implicitvox as iv
+from implicitvox.expr.examples import menger
 
 # %%
 vox = iv.voxelize(menger(3), RESOLUTION, normals=True)

@@ -7,13 +7,11 @@ A bracket and a knob from OpenSCAD
 ``facets="openscad"``, OpenSCAD's own facets) and the kernel voxelizes them.
 """
 # %%
-import sys
 from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-from common import RESOLUTION, out  # noqa: E402
+from implicitvox.gallery import RESOLUTION, out
 
-from csg import read_openscad  # noqa: E402
+from csg import read_openscad
 
 HERE = Path(__file__).resolve().parent
 

@@ -8,15 +8,11 @@ Dual contouring places each cell's vertex by its quadric error function (Ju et a
 marching cubes would bevel them.
 """
 # %%
-import sys
-from pathlib import Path
+from implicitvox.gallery import RESOLUTION, out
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-from common import RESOLUTION, out  # noqa: E402
-
-import csg  # noqa: E402
-import implicitvox as iv  # noqa: E402
-from implicitvox.io.rendering import render_mesh  # noqa: E402
+import csg
+import implicitvox as iv
+from implicitvox.io.rendering import render_mesh
 
 # %%
 solid = (csg.Box((2, 2, 2), center=True) - csg.Cylinder(h=3, r=0.5, center=True)

@@ -8,15 +8,11 @@ direction open, are split further. The mesh is closed and oriented outward; the 
 is reported in ``field_data``.
 """
 # %%
-import sys
-from pathlib import Path
+from implicitvox.gallery import RESOLUTION, out
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-from common import RESOLUTION, out  # noqa: E402
-
-import implicitvox as iv  # noqa: E402
-from implicitvox.expr.examples import example  # noqa: E402
-from implicitvox.io.rendering import render_mesh  # noqa: E402
+import implicitvox as iv
+from implicitvox.expr.examples import example
+from implicitvox.io.rendering import render_mesh
 
 # %%
 m = iv.mesh(example("gear"), resolution=max(24, RESOLUTION // 6))

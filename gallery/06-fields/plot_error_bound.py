@@ -11,15 +11,11 @@ S_r-closed, and is loose, as the paper says. The paper's observation: from r = 3
 largest error is below 0.1 voxel.
 """
 # %%
-import sys
-from pathlib import Path
-
 import numpy as np
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-from common import RESOLUTION, out, save_chart  # noqa: E402
+from implicitvox.gallery import RESOLUTION, out, save_chart
 
-from implicitvox.fields import analytic_error_bound, sphere_reconstruction_errors  # noqa: E402
+from implicitvox.fields import analytic_error_bound, sphere_reconstruction_errors
 
 # %%
 full = RESOLUTION >= 128

@@ -11,15 +11,11 @@ Mean signed offsets along rays, for radii 2 to 9 voxels
 (``implicitvox.fields.prefilter_comparison``).
 """
 # %%
-import sys
-from pathlib import Path
-
 import numpy as np
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-from common import RESOLUTION, out, save_chart  # noqa: E402
+from implicitvox.gallery import RESOLUTION, out, save_chart
 
-from implicitvox.fields import prefilter_comparison  # noqa: E402
+from implicitvox.fields import prefilter_comparison
 
 # %%
 full = RESOLUTION >= 128

@@ -12,12 +12,20 @@ in the same run, the cost of the equivalent plain numpy expression. The
 from __future__ import annotations
 
 import argparse
+import os
+import sys
 import time
 
 import numpy as np
 
 import implicitvox as ivx
 from implicitvox import atan2, hypot, sin, sqrt, x, y, z
+
+try:
+    from tests.benchmarks import tables
+except ImportError:        # run as a script from elsewhere
+    sys.path.insert(0, str(__import__("pathlib").Path(__file__).resolve().parents[2]))
+    from tests.benchmarks import tables
 
 
 def spheres_tree(n: int = 50, seed: int = 0):
@@ -44,6 +52,8 @@ def main() -> None:
     parser.add_argument("--n", type=int, default=1_000_000)
     parser.add_argument("--repeat", type=int, default=3)
     args = parser.parse_args()
+    load = "/".join(f"{v:.2f}" for v in os.getloadavg())
+    rows = []
     n = args.n
     rng = np.random.default_rng(0)
     pts = rng.uniform(-1.1, 1.1, (3, n))
@@ -69,6 +79,11 @@ def main() -> None:
         t_np = best_of(base, args.repeat) / n * 1e9 if base else float("nan")
         print(f"{name:<22}{len(f.tape):>6}{t_np:>13.1f}{t_point:>13.1f}{t_box:>17.1f}"
               f"{t_box / t_point:>8.2f}")
+        rows.append([name, len(f.tape), "-" if base is None else f"{t_np:.0f}", f"{t_point:.0f}",
+                     f"{t_box:.0f}", f"{t_box / t_point:.2f}"])
+    tables.write("eval", ["model", "instructions", "numpy ns/point", "point ns/point",
+                          "interval ns/box", "interval / point"], rows,
+                 "python tests/benchmarks/bench_eval.py " + " ".join(sys.argv[1:]), load)
 
 
 if __name__ == "__main__":

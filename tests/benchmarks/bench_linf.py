@@ -10,6 +10,7 @@ primitive's box grown by half its size, and for the bunny also near its surface
 """
 from __future__ import annotations
 
+import os
 import sys
 import time
 from pathlib import Path
@@ -21,6 +22,7 @@ from implicitvox.triangles.inputs import as_triangles
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2]))     # the repository root
 from tests.support.mesh_helpers import BUNNY  # noqa: E402
+from tests.benchmarks import tables  # noqa: E402
 
 N = 100_000
 
@@ -35,6 +37,8 @@ def per_point(fn, points, repeat=3) -> float:
 
 
 def main() -> None:
+    load = "/".join(f"{v:.2f}" for v in os.getloadavg())
+    table = []
     rng = np.random.default_rng(0)
     q, _ = np.linalg.qr(rng.normal(size=(3, 3)))
     box_pts = rng.uniform(-2, 2, (N, 3))
@@ -59,11 +63,13 @@ def main() -> None:
         plain = per_point(lambda p: prim.distance(p), box_pts)
         weighted = per_point(lambda p: prim.distance(p, w), box_pts)
         print(f"{name:<30} {plain:9.3f} {weighted:9.3f} {paper:>12}")
+        table.append([name, f"{plain:.2f}", f"{weighted:.2f}", paper])
     tri = rng.normal(size=(N, 3, 3))
     t = time.perf_counter()
     linf.triangle_distance(box_pts, tri)
-    print(f"{'triangle (one per point)':<30} {(time.perf_counter() - t) / N * 1e6:9.3f} "
-          f"{'':>9} {'10':>12}")
+    cost = (time.perf_counter() - t) / N * 1e6
+    print(f"{'triangle (one per point)':<30} {cost:9.3f} {'':>9} {'10':>12}")
+    table.append(["triangle (one per point)", f"{cost:.2f}", "-", "10"])
     if BUNNY.exists():
         v, f = as_triangles(str(BUNNY))
         t = time.perf_counter()
@@ -76,9 +82,13 @@ def main() -> None:
         bary = rng.dirichlet([1, 1, 1], N)
         near = np.einsum("ni,nij->nj", bary, v[f][k]) + rng.normal(0, 0.002, (N, 3))
         for name, pts in (("bunny, uniform in its box", uniform), ("bunny, near the surface", near)):
-            print(f"{name:<30} {per_point(mesh.distance, pts, repeat=1):9.3f} {'':>9} {'-':>12}")
+            cost = per_point(mesh.distance, pts, repeat=1)
+            print(f"{name:<30} {cost:9.3f} {'':>9} {'-':>12}")
+            table.append([f"{name} ({len(f):,} triangles)", f"{cost:.2f}", "-", "-"])
     else:
         print(f"bunny not found at {BUNNY}: skipped")
+    tables.write("linf", ["query", "µs per point", "weighted (µs)", "Varadhan §6.1 (µs)"], table,
+                 "python tests/benchmarks/bench_linf.py", load)
 
 
 if __name__ == "__main__":

@@ -16,6 +16,7 @@ Prints per resolution, in the same run:
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 import time
 from pathlib import Path
@@ -27,6 +28,9 @@ from implicitvox.triangles.inputs import as_triangles
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2]))     # the repository root
 from tests.support.mesh_helpers import BUNNY, sample_surface  # noqa: E402
+from tests.benchmarks import tables  # noqa: E402
+
+VARADHAN = {64: "1.65", 128: "2.01", 256: "3.51"}
 
 
 def best_of(repeat: int, run):
@@ -54,6 +58,8 @@ def main() -> None:
     parser.add_argument("--repeat", type=int, default=3)
     parser.add_argument("--no-trimesh", action="store_true", help="skip trimesh (slow)")
     args = parser.parse_args()
+    load = "/".join(f"{v:.2f}" for v in os.getloadavg())
+    rows = []
     v, f = as_triangles(str(BUNNY))
     tri = v[f]
     points = sample_surface(tri, 10**6, np.random.default_rng(0))
@@ -77,6 +83,8 @@ def main() -> None:
         idx = vox.grid.voxels_holding(points)
         miss = float(np.mean(~(vox.contains(idx[0]) | vox.contains(idx[1]))))
         print(f"{n:>5} {'implicitvox':<12} {secs:8.3f} {vox.count:>10,} {miss:8.2%} {1:6.2f}")
+        rows.append(["bunny", f"{n}³", "implicitvox voxelize_mesh", f"{secs:.2f}", f"{vox.count:,}",
+                     f"{miss:.2%}", VARADHAN.get(n, "-")])
         h = vox.voxel_size[0]
         if o3d is not None:
             t_o3d, grid = best_of(args.repeat, lambda: o3d.geometry.VoxelGrid
@@ -86,6 +94,8 @@ def main() -> None:
             m = missed_share(keys_of(got), pidx)
             print(f"{'':>5} {'open3d':<12} {t_o3d:8.3f} {len(got):>10,} {m:8.2%} "
                   f"{secs / t_o3d:6.2f}")
+            rows.append(["bunny", f"{n}³", f"Open3D {o3d.__version__} VoxelGrid",
+                         f"{t_o3d:.2f}", f"{len(got):,}", f"{m:.2%}", ""])
         if tm is not None:
             t_tm, grid = best_of(1, lambda: tm.voxelized(h))
             got = grid.sparse_indices
@@ -94,11 +104,18 @@ def main() -> None:
             m = missed_share(keys_of(got), pidx)
             print(f"{'':>5} {'trimesh':<12} {t_tm:8.3f} {len(got):>10,} {m:8.2%} "
                   f"{secs / t_tm:6.2f}")
+            rows.append(["bunny", f"{n}³", f"trimesh {trimesh.__version__} voxelized",
+                         f"{t_tm:.2f}", f"{len(got):,}", f"{m:.2%}", ""])
     print("\nUtah teapot, 32 Bezier patches (voxelize_bezier, flatness 1/8 voxel)")
     patches = ivx.utah_teapot()
     for n in args.res:
         secs, vox = best_of(args.repeat, lambda: ivx.voxelize_bezier(patches, n))
         print(f"{n:>5} {'implicitvox':<12} {secs:8.3f} {vox.count:>10,}")
+        rows.append(["Utah teapot, 32 patches", f"{n}³", "implicitvox voxelize_bezier",
+                     f"{secs:.2f}", f"{vox.count:,}", "-", ""])
+    tables.write("mesh", ["model", "N", "tool", "seconds (best of repeats)", "voxels",
+                          "surface samples missed", "Varadhan Table 2 (s)"], rows,
+                 "python tests/benchmarks/bench_mesh.py " + " ".join(sys.argv[1:]), load)
 
 
 if __name__ == "__main__":
