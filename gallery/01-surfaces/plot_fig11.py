@@ -11,14 +11,24 @@ voxel, as Stolte shows them) and as a mesh within a guaranteed Hausdorff distanc
 # %%
 from implicitvox.gallery import RESOLUTION, out
 
+import numpy as np
+
 import implicitvox as iv
-from implicitvox.expr.examples import blobby, lobed_plate, sinsin
+from implicitvox import exp, x, y, z
+from implicitvox.expr.examples import lobed_plate, sinsin
+from implicitvox.expr.shape import ExprShape
 from implicitvox.io.rendering import render_mesh
 
 # %%
+# Ten spheres blended as a sum of Gaussians (Scene 1), their centres along a helix so
+# that each shows and each blends into the next.
+angle = np.linspace(0, 1.6 * np.pi, 10)
+centres = np.stack([0.55 * np.cos(angle), 0.55 * np.sin(angle), np.linspace(-0.6, 0.6, 10)], 1)
+blobs = 0.5 - sum(exp(-40.0 * ((x - cx) ** 2 + (y - cy) ** 2 + (z - cz) ** 2))
+                  for cx, cy, cz in centres)
 scenes = {"fig11d-lobed-plate": ("rho - (1.2 + 0.05 sin 3 theta), a plate", lobed_plate()),
           "fig11e-sinsin48": ("sin(4 theta) sin(8 phi) - r", sinsin(4, 8)),
-          "fig11f-blobby10": ("ten blobby spheres", blobby(10, seed=11))}
+          "fig11f-blobby10": ("ten blended spheres", ExprShape(blobs, ((-1.0,) * 3, (1.0,) * 3)))}
 for name, (title, shape) in scenes.items():
     vox = iv.voxelize(shape, resolution=RESOLUTION, normals=True)
     print(vox.render(out(f"{name}.png"), title=f"{title}: {vox.count:,} voxels at "
