@@ -82,8 +82,10 @@ class Suitability:
 
     def __str__(self) -> str:
         verdict = "suitable" if self.suitable else "not suitable"
-        return (f"S_r-open up to r = {self.r_open:.2f}, S_r-closed up to r = "
-                f"{self.r_closed:.2f}{'+' if self.r_closed >= self.max_radius else ''} voxels: "
+        def shown(r: float) -> str:
+            return f"{r:.2f}{'+' if r >= self.max_radius else ''}"
+        return (f"S_r-open up to r = {shown(self.r_open)}, S_r-closed up to r = "
+                f"{shown(self.r_closed)} voxels: "
                 f"{verdict} (r {'>' if self.suitable else '<='} √6 = {CRITICAL_RADIUS:.3f}); "
                 f"predicted trilinear error at most {self.predicted_error:.3g} voxels")
 
