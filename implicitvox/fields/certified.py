@@ -231,10 +231,9 @@ def _bracket(tape, nm: _Norm, p, w, tree, boxes_lo, boxes_hi, half_diag, scale, 
              tolerance, max_levels, stats):
     """``(L, U)`` for one block of points (see the module docstring)."""
     n = len(p)
-    upper = np.minimum(_newton_upper(tape, nm, p, w, scale), np.inf)
-    lower = np.zeros(n)
-    if tree is None:
-        return np.full(n, limit), np.full(n, limit)
+    if tree is None:                    # no box may hold the surface: none within reach
+        return np.full(n, limit), np.full(n, np.inf)
+    upper = _newton_upper(tape, nm, p, w, scale)
     # the initial pairs: boxes whose centre is within reach (a superset, then exact)
     reach = np.minimum(upper, limit)
     euclid_reach = reach * (1.0 if nm.euclidean else np.sqrt(3) * float(np.max(w))) + half_diag

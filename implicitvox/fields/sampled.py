@@ -127,7 +127,9 @@ def distance_field(shape: Any, resolution: Union[int, tuple[int, int, int], None
     mesh = _as_mesh(shape)
     t0 = time.perf_counter()
     if mesh is not None:
-        vox = voxelize_mesh((mesh.tri.reshape(-1, 3), np.arange(3 * len(mesh.tri)).reshape(-1, 3)),
+        # the triangles with their shared vertices again (the fill needs the connectivity)
+        vertices, corners = np.unique(mesh.tri.reshape(-1, 3), axis=0, return_inverse=True)
+        vox = voxelize_mesh((vertices, corners.reshape(-1, 3)),
                             resolution, bounds=bounds, voxel_size=voxel_size,
                             interior=mesh.closed, max_memory=budget,
                             progress=lambda s: report(0.2 * s))

@@ -127,6 +127,14 @@ def test_mesh_fields_equal_brute_force_over_every_triangle():
         assert np.allclose(np.abs(d), brute, rtol=0, atol=1e-12)
         inside = np.linalg.norm(p, axis=1) < 0.9
         assert np.all(d[inside] < 0)
+        # off the band: the background, with the side proved by the mesh's solid fill
+        g = field.grid
+        ijk = np.stack(np.meshgrid(*[np.arange(k) for k in g.shape], indexing="ij"),
+                       -1).reshape(-1, 3)
+        stored = field.at(ijk)
+        far = np.abs(stored) == field.background
+        radius = np.linalg.norm(g.centers(ijk[far]), axis=1)
+        assert far.any() and np.all(np.sign(stored[far]) == np.sign(radius - 1))
 
 
 @pytest.mark.parametrize("norm", ["euclidean", "linf"])
