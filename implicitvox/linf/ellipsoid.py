@@ -92,6 +92,54 @@ class Ellipsoid(Primitive):
         half = np.sqrt(np.diag(self.Qinv))
         return tuple((self.center - half).tolist()), tuple((self.center + half).tolist())
 
+    def euclidean_distance(self, points: Any) -> np.ndarray:
+        """Signed Euclidean distance (Eberly, *Distance from a Point to an Ellipse, an
+        Ellipsoid, or a Hyperellipsoid*, 2013). In the ellipsoid's frame, with ``y`` the
+        point's absolute coordinates and ``e`` the semi-axes, the nearest point is
+        ``x_i = e_i² y_i / (t + e_i²)`` for the root ``t > -e_min²`` of the decreasing
+        ``F(t) = Σ (e_i y_i / (t + e_i²))² - 1``, found by bisection to the last float.
+        Where ``y`` vanishes along the shortest axes and ``F`` stays negative there, the
+        nearest point leaves that plane (a point on the medial disc): the other
+        coordinates take ``t = -e_min²`` and the shortest axes the rest of the unit
+        norm. Both candidates are points of the surface (the first is kept only where
+        it is one to 1e-9, which rounding near the disc can spoil), so the nearer of
+        them is the distance."""
+        p = as_points(points)
+        y = np.abs((p - self.center) @ self.rotation)             # local, first octant
+        e = self.radii
+        e2 = e * e
+        inside = np.sum((y / e) ** 2, axis=1) < 1.0
+        lo = np.full(len(p), -float(e2.min()))
+        hi = float(e.max()) * np.linalg.norm(y, axis=1)
+        with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+            for _ in range(200):
+                mid = 0.5 * (lo + hi)
+                F = np.sum((e * y / (mid[:, None] + e2)) ** 2, axis=1) - 1.0
+                done = (mid <= lo) | (mid >= hi)
+                lo = np.where(done | (F <= 0), lo, mid)
+                hi = np.where(done | (F > 0), hi, mid)
+                if done.all():
+                    break
+            t = 0.5 * (lo + hi)
+            x = e2 * y / (t[:, None] + e2)
+            # a candidate only where it is on the surface (not where t + e² rounded away)
+            on = np.all(np.isfinite(x), axis=1) & \
+                (np.abs(np.sum((x / e) ** 2, axis=1) - 1.0) <= 1e-9)
+            regular = np.where(on, np.linalg.norm(np.where(on[:, None], x, 0.0) - y, axis=1),
+                               np.inf)
+            # the medial-disc candidate: t = -e_min² for the other axes, the rest of the
+            # unit norm along the shortest ones (parallel to the point's own component)
+            short = e == e.min()
+            others = ~short
+            xo = e2[others] * y[:, others] / (e2[others] - e2.min())
+            rest = 1.0 - np.sum((xo / e[others]) ** 2, axis=1)
+            along = np.linalg.norm(y[:, short], axis=1)
+            off = np.sqrt(np.sum((xo - y[:, others]) ** 2, axis=1)
+                          + (e.min() * np.sqrt(np.maximum(rest, 0.0)) - along) ** 2)
+            medial = np.where(rest >= 0, off, np.inf)
+        d = np.fmin(regular, medial)
+        return np.where(inside, -d, d)
+
     def distance(self, points: Any, weights: Any = None) -> np.ndarray:
         p = as_points(points)
         w = as_weights(weights, len(p))

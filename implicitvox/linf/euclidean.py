@@ -1,8 +1,9 @@
 """Euclidean distances of the same primitives, for distance fields (Bærentzen §2, eq. 2).
 
 The max-norm distances of this package answer the exact voxel test; a
-distance field in the ordinary norm needs the Euclidean ones. These are the
-kernels the primitives' ``euclidean_distance`` methods share: closest points
+distance field in the ordinary norm needs the Euclidean ones (the primitives'
+``euclidean_distance`` methods: sphere, half-space, convex polyhedron, cylinder
+and cone, ring torus, ellipsoid, triangle mesh). These are the kernels they share: closest points
 on triangles (vectorized, Ericson's region tests) and on segments of a
 meridian half-plane (solids of revolution: cylinders, cones, tori).
 
