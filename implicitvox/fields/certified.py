@@ -234,19 +234,23 @@ def _bracket(tape, nm: _Norm, p, w, tree, boxes_lo, boxes_hi, half_diag, scale, 
     if tree is None:                    # no box may hold the surface: none within reach
         return np.full(n, limit), np.full(n, np.inf)
     upper = _newton_upper(tape, nm, p, w, scale)
-    # the initial pairs: boxes whose centre is within reach (a superset, then exact)
+    # the initial pairs: boxes whose centre is within reach (a superset, then exact),
+    # gathered for groups of points with at most MAX_PAIRS pairs between them
     reach = np.minimum(upper, limit)
     euclid_reach = reach * (1.0 if nm.euclidean else np.sqrt(3) * float(np.max(w))) + half_diag
-    found = tree.query_ball_point(p, euclid_reach)
-    counts = np.fromiter(map(len, found), dtype=np.int64, count=n)
-    pt = np.repeat(np.arange(n), counts)
-    box = np.fromiter(itertools.chain.from_iterable(found), dtype=np.int64,
-                      count=int(counts.sum()))
-    lo, hi = boxes_lo[box], boxes_hi[box]
+    counts = np.asarray(tree.query_ball_point(p, euclid_reach, return_length=True),
+                        dtype=np.int64)
     lower = np.where(counts == 0, reach, 0.0)     # no box within reach: nothing nearer
     state = {"upper": upper, "lower": lower, "open": counts > 0}
-    _refine(tape, nm, p, w, pt, lo, hi, box.astype(np.int64), 0, state, limit, tolerance,
-            max_levels, stats)
+    group = np.cumsum(counts) // MAX_PAIRS
+    for g in np.unique(group[counts > 0]):
+        rows = np.flatnonzero((group == g) & (counts > 0))
+        found = tree.query_ball_point(p[rows], euclid_reach[rows])
+        box = np.fromiter(itertools.chain.from_iterable(found), dtype=np.int64,
+                          count=int(counts[rows].sum()))
+        pt = np.repeat(rows, counts[rows])
+        _refine(tape, nm, p, w, pt, boxes_lo[box], boxes_hi[box], box, 0, state, limit,
+                tolerance, max_levels, stats)
     lower, upper = state["lower"], state["upper"]
     # outward: a relative margin, and one for the roundings of coordinates of this size
     slack = _MARGIN * (1.0 + float(np.max(np.abs(p))))

@@ -47,6 +47,8 @@ TOLERANCE = 1e-3
 _BYTES_PER_SAMPLE = 8 + 8 + 1 + 48
 #: samples computed per call (bounded temporaries, progress steps)
 _CHUNK = 1 << 16
+#: voxels the certified search first looks within, for a field everywhere
+_FIRST_REACH = 5
 
 
 def estimate_bytes(bricks: int) -> int:
@@ -148,7 +150,8 @@ def distance_field(shape: Any, resolution: Union[int, tuple[int, int, int], None
         all_bricks(grid.shape)
     refuse_over_budget(estimate_bytes(len(keys)), budget,
                        f"a distance field of {len(keys):,} bricks at {grid.shape}")
-    reach = max(grid.shape) if band is None else band + 1
+    # where the certified search looks first (it widens where no zero is proved)
+    reach = _FIRST_REACH if band is None else band + 1
     limit = reach * float(h.max()) * (math.sqrt(3) if norm == "euclidean" else 1.0)
 
     compiled: list = []          # the function and the surface boxes, built on first use
