@@ -29,6 +29,7 @@ from typing import Any, Callable, Optional
 import numpy as np
 
 from .. import validate
+from ..octree.budget import size_text
 from ..octree.grid import Grid
 from ..octree.voxels import DEFAULT_DENSE_LIMIT, Voxels
 from .bricks import BRICK, BrickIndex, brick_coords
@@ -195,8 +196,7 @@ class DistanceField:
         need = 8 * int(np.prod(self.grid.shape, dtype=np.float64))
         if need > max_memory:
             raise MemoryError(f"a dense {self.grid.shape} distance field needs "
-                              f"{need / 2**30:.2f} GiB, over max_memory="
-                              f"{max_memory / 2**30:.2f} GiB")
+                              f"{size_text(need)}, over max_memory={size_text(max_memory)}")
         dense = np.full(self.grid.shape, self.background)
         if self.voxels is not None:
             solid = self.voxels.to_dense(interior=True, max_memory=max_memory)

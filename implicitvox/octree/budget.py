@@ -18,7 +18,7 @@ from typing import Any, Optional
 
 from .. import validate
 
-__all__ = ["memory_budget", "available_memory", "refuse_over_budget"]
+__all__ = ["memory_budget", "available_memory", "refuse_over_budget", "size_text"]
 
 
 def available_memory() -> int:
@@ -88,6 +88,16 @@ def memory_budget(max_memory: Any) -> int:
 def refuse_over_budget(need: int, budget: int, what: str) -> None:
     """Raise ``MemoryError`` saying ``what`` needs ``need`` bytes, if over ``budget``."""
     if need > budget:
-        raise MemoryError(f"{what} needs an estimated {need / 2**30:.2f} GiB, over the budget "
-                          f"of {budget / 2**30:.2f} GiB; lower the resolution or raise "
-                          "max_memory")
+        raise MemoryError(f"{what} needs an estimated {size_text(need)}, over the budget "
+                          f"of {size_text(budget)}; lower the resolution or raise max_memory")
+
+
+def size_text(nbytes: float) -> str:
+    """Bytes in GiB, or in MiB below a GiB (so a small budget does not read as 0.00 GiB).
+
+    >>> size_text(3 * 2**30), size_text(5 * 2**20)
+    ('3.00 GiB', '5.0 MiB')
+    """
+    if nbytes >= 2**30:
+        return f"{nbytes / 2**30:.2f} GiB"
+    return f"{nbytes / 2**20:.1f} MiB"

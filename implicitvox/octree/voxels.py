@@ -19,6 +19,7 @@ from typing import Any, Callable, Optional, Protocol, runtime_checkable
 import numpy as np
 
 from .. import validate
+from .budget import size_text
 from .grid import Grid
 from .store import Octree
 
@@ -154,8 +155,8 @@ class Voxels:
         """
         need = int(np.prod(self.grid.shape))
         if need > max_memory:
-            raise MemoryError(f"a dense {self.grid.shape} array needs {need / 2**30:.2f} GiB, over "
-                              f"max_memory={max_memory / 2**30:.2f} GiB")
+            raise MemoryError(f"a dense {self.grid.shape} array needs {size_text(need)}, over "
+                              f"max_memory={size_text(max_memory)}")
         dense = np.zeros(self.grid.shape, dtype=bool)
         c = self.coords()
         dense[c[:, 0], c[:, 1], c[:, 2]] = True
