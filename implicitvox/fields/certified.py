@@ -12,15 +12,15 @@ Euclidean or the (weighted) max-norm, by branch and bound over boxes:
   every level, from the plane that approximates ``f`` in each kept box.
 * **lower bound** ``L``: every surface point lies in one of the boxes the
   voxelizer kept (it misses none). A (point, box) pair is dropped when the
-  box's interval enclosure excludes 0, and bounded below by the larger of
-  the distance to the box and the distance to the *slab* that holds the
-  box's zeros: by the mean value theorem ``f(q) ∈ f(c) + [∇f](box)·(q - c)``
-  for ``q`` in the box, so a zero ``q`` satisfies
-  ``g·(q - c) ∈ -[f(c)] ∓ Σ_i rad([∇f]_i) h_i`` with ``g`` the midpoint of
-  the gradient enclosure and ``h`` the half-sizes. The slab's distance is
-  exact to second order in the box size, so near the contact only a few
-  boxes survive at each level, and they are split until ``U - L`` is below
-  the tolerance (Varadhan §4.3 refines a hardware estimate by local
+  box's interval enclosure excludes 0, and bounded below by the distance to
+  the part of the box inside the *slab* that holds the box's zeros: by the
+  mean value theorem ``f(q) ∈ f(c) + [∇f](box)·(q - c)`` for ``q`` in the box,
+  so a zero ``q`` satisfies ``g·(q - c) ∈ -[f(c)] ∓ Σ_i rad([∇f]_i) h_i`` with
+  ``g`` the midpoint of the gradient enclosure and ``h`` the half-sizes. The
+  distance to box ∩ slab is computed exactly in both norms (a projection onto
+  a box and a hyperplane; a cube growing into it); the slab is thin to second
+  order in the box size, so near the contact few boxes survive at each level,
+  and they are split until ``U - L`` is below the tolerance (Varadhan §4.3 refines a hardware estimate by local
   optimization; this refines by intervals, so the result is proved).
 
 The field stores ``(U + L) / 2`` with the error bound ``(U - L) / 2``. Each
@@ -343,7 +343,7 @@ def _pair_bounds(tape, nm: _Norm, p, w, pt, lo, hi, bid):
         dual = nm.dual(g, q_w)
         to_slab = np.maximum(np.maximum(s_lo - gp, gp - s_hi), 0.0) / dual
         if nm.euclidean:
-            to_both = _euclidean_box_slab(q_pt, lo, hi, g, s_lo, s_hi, to_slab)
+            to_both = _euclidean_box_slab(q_pt, lo, hi, g, s_lo, s_hi)
         else:
             to_both = _linf_box_slab(q_pt, q_w, lo, hi, g, s_lo, s_hi)
     slab_ok = valid & (dual > 0) & np.isfinite(to_slab) & (clo <= chi) & ~np.isnan(to_both)
@@ -367,51 +367,43 @@ def _pair_bounds(tape, nm: _Norm, p, w, pt, lo, hi, bid):
     return lb, pt[r], upper
 
 
-_CORNERS = np.array(list(np.ndindex(2, 2, 2)), dtype=bool)                    # (8, 3)
-_EDGES = np.array([(i, j) for i in range(8) for j in range(i + 1, 8)
-                   if np.sum(_CORNERS[i] != _CORNERS[j]) == 1])                  # (12, 2)
-
-
-def _euclidean_box_slab(p, lo, hi, g, s_lo, s_hi, to_slab):
-    """A lower bound of the Euclidean distance from ``p`` to (box ∩ slab): with ``n``
-    the slab's normal, ``q - p = a n + v`` (``v ⊥ n``) with ``|a| >= to_slab``, and
-    along the unit ``t`` of ``p`` less the box centre, projected off ``n``,
-    ``|v| >= t·p - max_q t·q`` over the polytope. That maximum lies at a vertex of
-    box ∩ slab: a box corner inside the slab, or where a box edge crosses one of
-    the slab's planes. ``inf`` where box ∩ slab is empty (no zero in the box).
-    Written on (pairs, 8 corners) and (pairs, 12 edges) arrays: a corner's value of
-    a linear function is its value at ``lo`` plus the steps of its high axes."""
-    n = g / np.linalg.norm(g, axis=1, keepdims=True)
-    step = hi - lo
-    bits = _CORNERS.astype(np.float64)                                       # (8, 3)
-    level = np.einsum("ij,ij->i", g, lo)[:, None] + (g * step) @ bits.T      # g·corner
-    inside = (level >= s_lo[:, None]) & (level <= s_hi[:, None])
-    a, b = _EDGES[:, 0], _EDGES[:, 1]
-    la, lb = level[:, a], level[:, b]                                        # (m, 12)
-    d = p - 0.5 * (lo + hi)
-    along = np.einsum("ij,ij->i", d, n)
-    lateral = d - along[:, None] * n
-    lateral -= np.einsum("ij,ij->i", lateral, n)[:, None] * n          # once more: ⊥ n
-    length = np.linalg.norm(lateral, axis=1)
-    size = np.linalg.norm(step, axis=1)
-    # a direction within rounding of n would count the normal distance twice: none then
-    usable = length > 1e-9 * (np.abs(along) + size)
-    t = lateral / np.where(usable, length, 1.0)[:, None]
-    value = np.einsum("ij,ij->i", t, lo)[:, None] + (t * step) @ bits.T      # t·corner
-    va, vb = value[:, a], value[:, b]
-    reach = np.max(np.where(inside, value, -np.inf), axis=1)
-    feasible = inside.any(axis=1)
-    for s in (s_lo, s_hi):
-        with np.errstate(invalid="ignore", divide="ignore"):
-            tau = (s[:, None] - la) / (lb - la)
-        hit = (tau >= 0) & (tau <= 1)
-        reach = np.maximum(reach, np.max(np.where(hit, va + tau * (vb - va), -np.inf), axis=1))
-        feasible |= hit.any(axis=1)
-    # what t's rounding off the plane (|t.n|) could add along n, over the polytope
-    leak = np.abs(np.einsum("ij,ij->i", t, n)) * (np.abs(along) + size)
-    excess = np.maximum(np.einsum("ij,ij->i", t, p) - reach - leak, 0.0)
-    excess = np.where(usable, excess, 0.0)
-    return np.where(feasible, np.sqrt(to_slab * to_slab + excess * excess), np.inf)
+def _euclidean_box_slab(p, lo, hi, g, s_lo, s_hi):
+    """The Euclidean distance from ``p`` to box ∩ slab, exactly (``inf`` where it is
+    empty: no zero in the box). If the box's nearest point to ``p`` is in the slab it
+    is the answer; else the nearest point of box ∩ {g·q = s} (the slab's near face)
+    is ``clip(p + λ g, lo, hi)`` for the ``λ`` where ``φ(λ) = g·clip(p + λ g, lo, hi)``,
+    a non-decreasing piecewise linear function with a break where each coordinate
+    meets a face of the box, reaches ``s`` (the projection onto a box and a hyperplane,
+    as in the continuous quadratic knapsack). The breaks are sorted and ``φ`` is
+    interpolated between the two around ``s``; all pairs at once."""
+    q0 = np.clip(p, lo, hi)
+    v0 = np.einsum("ij,ij->i", g, q0)
+    above = v0 > s_hi
+    outside = (v0 < s_lo) | above
+    direction = np.where(above[:, None], -g, g)               # towards the slab
+    target = np.where(above, -s_hi, s_lo)
+    moving = direction != 0
+    with np.errstate(divide="ignore", invalid="ignore"):
+        breaks = np.concatenate([np.where(moving, (lo - p) / direction, np.inf),
+                                 np.where(moving, (hi - p) / direction, np.inf)], axis=1)
+    breaks = np.where(breaks > 0, breaks, np.inf)
+    breaks = np.sort(np.concatenate([np.zeros((len(p), 1)), breaks], axis=1), axis=1)
+    finite = np.isfinite(breaks)
+    lam = np.where(finite, breaks, 0.0)                        # (m, 7)
+    moved = np.clip(p[:, None] + lam[..., None] * direction[:, None], lo[:, None], hi[:, None])
+    phi = np.where(finite, np.einsum("mkj,mj->mk", moved, direction), -np.inf)
+    reached = phi >= target[:, None]
+    first = np.argmax(reached, axis=1)
+    found = reached.any(axis=1)
+    before = np.maximum(first - 1, 0)[:, None]
+    l0, l1 = np.take_along_axis(lam, before, 1)[:, 0], np.take_along_axis(lam, first[:, None], 1)[:, 0]
+    f0, f1 = np.take_along_axis(phi, before, 1)[:, 0], np.take_along_axis(phi, first[:, None], 1)[:, 0]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        step = np.where(f1 > f0, l0 + (target - f0) / (f1 - f0) * (l1 - l0), l1)
+    step = np.where(found, step, 0.0)
+    q = np.clip(p + step[:, None] * direction, lo, hi)
+    d = np.where(outside, np.linalg.norm(q - p, axis=1), np.linalg.norm(q0 - p, axis=1))
+    return np.where(outside & ~found, np.inf, d)
 
 
 def _first_reach(start: np.ndarray, slope: np.ndarray, stop: np.ndarray, target: np.ndarray

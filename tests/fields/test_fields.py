@@ -309,8 +309,16 @@ def test_box_slab_lower_bounds_never_exceed_the_distance_to_box_and_slab():
         q = q[(q @ g[0] >= s_lo[0]) & (q @ g[0] <= s_hi[0])]
         if not len(q):
             continue
-        euclid = _euclidean_box_slab(p, lo, hi, g, s_lo, s_hi, to_slab)[0]
+        euclid = _euclidean_box_slab(p, lo, hi, g, s_lo, s_hi)[0]
         assert euclid <= np.linalg.norm(q - p, axis=1).min() + 1e-12
+        if trial < 20:      # and exact: a quadratic programme's optimum, found by scipy
+            from scipy.optimize import Bounds, LinearConstraint, minimize
+            best = minimize(lambda v: np.sum((v - p[0]) ** 2), 0.5 * (lo[0] + hi[0]),
+                            jac=lambda v: 2 * (v - p[0]), method="SLSQP",
+                            bounds=Bounds(lo[0], hi[0]),
+                            constraints=[LinearConstraint(g, s_lo, s_hi)],
+                            options={"ftol": 1e-14, "maxiter": 500})
+            assert abs(euclid - np.sqrt(best.fun)) <= 1e-5
         cheb = _linf_box_slab(p, np.ones((1, 3)), lo, hi, g, s_lo, s_hi)[0]
         assert cheb <= np.abs(q - p).max(axis=1).min() + 1e-12
 
