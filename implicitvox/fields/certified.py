@@ -20,8 +20,9 @@ Euclidean or the (weighted) max-norm, by branch and bound over boxes:
   distance to box ∩ slab is computed exactly in both norms (a projection onto
   a box and a hyperplane; a cube growing into it); the slab is thin to second
   order in the box size, so near the contact few boxes survive at each level,
-  and they are split until ``U - L`` is below the tolerance (Varadhan §4.3 refines a hardware estimate by local
-  optimization; this refines by intervals, so the result is proved).
+  and they are split until ``U - L`` is below the tolerance (Varadhan §4.3
+  refines a hardware estimate by local optimization; this refines by
+  intervals, so the result is proved).
 
 The field stores ``(U + L) / 2`` with the error bound ``(U - L) / 2``. Each
 bound is computed in floating point and then moved outward by a relative
@@ -396,8 +397,9 @@ def _euclidean_box_slab(p, lo, hi, g, s_lo, s_hi):
     first = np.argmax(reached, axis=1)
     found = reached.any(axis=1)
     before = np.maximum(first - 1, 0)[:, None]
-    l0, l1 = np.take_along_axis(lam, before, 1)[:, 0], np.take_along_axis(lam, first[:, None], 1)[:, 0]
-    f0, f1 = np.take_along_axis(phi, before, 1)[:, 0], np.take_along_axis(phi, first[:, None], 1)[:, 0]
+    after = first[:, None]
+    l0, l1 = np.take_along_axis(lam, before, 1)[:, 0], np.take_along_axis(lam, after, 1)[:, 0]
+    f0, f1 = np.take_along_axis(phi, before, 1)[:, 0], np.take_along_axis(phi, after, 1)[:, 0]
     with np.errstate(divide="ignore", invalid="ignore"):
         step = np.where(f1 > f0, l0 + (target - f0) / (f1 - f0) * (l1 - l0), l1)
     step = np.where(found, step, 0.0)

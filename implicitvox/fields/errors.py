@@ -26,10 +26,11 @@ import numpy as np
 
 from .. import validate
 from ..linf.sphere import Sphere
-from .bounds import analytic_error_bound, fibonacci_directions
+from ..meshing.hausdorff import sphere_directions
+from .bounds import analytic_error_bound
 from .sampled import distance_field
 
-__all__ = ["analytic_error_bound", "sphere_reconstruction_errors", "fibonacci_directions"]
+__all__ = ["analytic_error_bound", "sphere_reconstruction_errors"]
 
 _BISECT = 48
 
@@ -43,7 +44,7 @@ def sphere_reconstruction_errors(radius: float, *, offsets: int = 8, rays: int =
     offsets = validate.int_in(offsets, "offsets", 1, 1000)
     rays = validate.int_in(rays, "rays", 1, 100000)
     rng = np.random.default_rng(seed)
-    directions = fibonacci_directions(rays)
+    directions = sphere_directions(rays)
     errors = []
     for centre in rng.random((offsets, 3)):
         reach = radius + 3.0

@@ -31,6 +31,7 @@ from typing import Any, Callable, Optional
 import numpy as np
 
 from ..expr.shape import AMBIGUOUS, FULL, voxel_classifier
+from ..linf.norm import float_bisection
 
 __all__ = ["Kernel", "choose_kernel", "exact_distance_function", "linf_by_box_test"]
 
@@ -90,17 +91,7 @@ def linf_by_box_test(classify: Callable, points: np.ndarray, weights: Any,
             if not miss.any():
                 break
             hi = np.where(miss, hi * 4, hi)
-    lo_bits = np.zeros(n, dtype=np.int64)
-    hi_bits = hi.astype(np.float64).view(np.int64).copy()
-    for _ in range(64):
-        active = hi_bits - lo_bits > 1
-        if not active.any():
-            break
-        mid = lo_bits + (hi_bits - lo_bits) // 2
-        ok = meets(mid.view(np.float64))
-        hi_bits = np.where(active & ok, mid, hi_bits)
-        lo_bits = np.where(active & ~ok, mid, lo_bits)
-    t_lo, t_hi = lo_bits.view(np.float64), hi_bits.view(np.float64)
+    t_lo, t_hi = float_bisection(meets, hi)
     at_lo = meets(t_lo)
     t = np.where(at_lo, t_lo, t_hi)
     # the sign: the largest cube that does not meet the surface is inside or outside

@@ -37,10 +37,10 @@ from ..eval.function import Function
 from ..expr.shape import as_shape
 from ..octree.grid import Grid, grid_of
 from ..octree.voxels import DEFAULT_DENSE_LIMIT
-from .bounds import fibonacci_directions
+from ..meshing.hausdorff import sphere_directions
 
-__all__ = ["bartlett_kernel", "prefiltered", "prefiltered_samples", "trilinear", "prefilter_comparison",
-           "isosurface_offsets", "QUADRATURE"]
+__all__ = ["bartlett_kernel", "prefiltered", "prefiltered_samples", "trilinear",
+           "prefilter_comparison", "isosurface_offsets", "QUADRATURE"]
 
 #: quadrature points per filter radius, per axis
 QUADRATURE = 8
@@ -122,7 +122,7 @@ def isosurface_offsets(sample: Callable[[np.ndarray], np.ndarray], level: float,
     cylinder about it (rays perpendicular to it). The crossing is searched within
     ``reach`` of the surface, by bisection. Negative: the isosurface lies inside."""
     centre = np.asarray(centre, dtype=np.float64)
-    directions = fibonacci_directions(rays)
+    directions = sphere_directions(rays)
     if axis is not None:
         a = np.asarray(axis, dtype=np.float64) / np.linalg.norm(axis)
         directions = directions - (directions @ a)[:, None] * a

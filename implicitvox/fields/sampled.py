@@ -29,7 +29,6 @@ from ..expr.nodes import Expr
 from ..expr.shape import as_shape
 from ..linf.mesh import TriangleMesh
 from ..octree.budget import memory_budget, refuse_over_budget
-from ..octree.grid import grid_of
 from ..triangles.inputs import as_triangles
 from ..voxelizers.implicit import voxelize
 from ..voxelizers.mesh import voxelize_mesh

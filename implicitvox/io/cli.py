@@ -260,8 +260,7 @@ def _mesh(args: argparse.Namespace) -> int:
     if args.out:
         print(f"wrote {save_mesh(result, args.out)}")
     if args.render:
-        name = args.example or os.path.basename(args.model)
-        print(f"rendered {render_mesh(result, args.render, title=name)}")
+        print(f"rendered {render_mesh(result, args.render, title=_model_name(args))}")
     return 0
 
 
@@ -273,6 +272,11 @@ def _suitability(shape: Any, args: argparse.Namespace, bounds: Any, max_memory: 
     answer = suitability(shape, args.resolution, bounds=bounds, voxel_size=args.voxel_size,
                          max_memory=max_memory)
     print(f"suitability: {answer}")
+
+
+def _model_name(args: argparse.Namespace) -> str:
+    """The model's name for a picture's title: the example, or the file's name."""
+    return args.example or os.path.basename(args.model)
 
 
 def _is_mesh(args: argparse.Namespace) -> bool:
@@ -305,8 +309,8 @@ def _field(args: argparse.Namespace) -> int:
     if args.out:
         print(f"wrote {field.save(args.out)}")
     if args.render:
-        name = args.example or os.path.basename(args.model)
-        print(f"rendered {render_mesh(field.isosurface(), args.render, title=name)}")
+        picture = render_mesh(field.isosurface(), args.render, title=_model_name(args))
+        print(f"rendered {picture}")
     return 0
 
 
@@ -342,8 +346,7 @@ def _voxelize(args: argparse.Namespace) -> int:
     if args.out:
         print(f"wrote {vox.save(args.out)}")
     if args.render:
-        name = args.example or os.path.basename(args.model)
-        title = f"{name} {'x'.join(map(str, vox.resolution))}"
+        title = f"{_model_name(args)} {'x'.join(map(str, vox.resolution))}"
         print(f"rendered {vox.render(args.render, title=title)}")
     return 0
 

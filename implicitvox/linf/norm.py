@@ -19,7 +19,7 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["as_points", "as_weights", "support", "in_blocks"]
+__all__ = ["as_points", "as_weights", "support", "in_blocks", "float_bisection"]
 
 
 def as_points(points: Any) -> np.ndarray:
@@ -60,3 +60,21 @@ def in_blocks(fn, p: np.ndarray, w: np.ndarray, size: int) -> np.ndarray:
     for s in range(0, len(p), size):
         out[s:s + size] = fn(p[s:s + size], w[s:s + size])
     return out
+
+
+def float_bisection(test, hi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``(lo, hi)``: adjacent non-negative floats bracketing where the monotone ``test(t)``
+    (false, then true; ``test(hi)`` true) turns true, by bisection on the bit patterns
+    of non-negative floats (64 steps at most). ``lo`` is 0 where nothing below ``hi``
+    was found false, so ``test(lo)`` may hold there (a point on the surface)."""
+    lo_bits = np.zeros(len(hi), dtype=np.int64)
+    hi_bits = np.asarray(hi, dtype=np.float64).view(np.int64).copy()
+    for _ in range(64):
+        active = hi_bits - lo_bits > 1
+        if not active.any():
+            break
+        mid = lo_bits + (hi_bits - lo_bits) // 2
+        ok = test(mid.view(np.float64))
+        hi_bits = np.where(active & ok, mid, hi_bits)
+        lo_bits = np.where(active & ~ok, mid, lo_bits)
+    return lo_bits.view(np.float64), hi_bits.view(np.float64)

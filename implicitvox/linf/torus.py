@@ -44,7 +44,7 @@ from .. import expr as ex
 
 from .classify import Primitive
 from .euclidean import meridian
-from .norm import as_points, as_weights, in_blocks
+from .norm import as_points, as_weights, float_bisection, in_blocks
 from .torus_frame import TorusFrame
 
 __all__ = ["Torus"]
@@ -173,17 +173,7 @@ class Torus(Primitive):
         # an upper end where the test holds: a box reaching past the whole torus
         reach = (np.abs(q) + np.array([self.R + self.r, self.R + self.r, self.r])) / w
         hi = np.max(reach, axis=1) * 2.0 + 1.0
-        lo_bits = np.zeros(n, dtype=np.int64)
-        hi_bits = hi.view(np.int64).copy()
-        for _ in range(64):
-            active = hi_bits - lo_bits > 1
-            if not active.any():
-                break
-            mid = lo_bits + (hi_bits - lo_bits) // 2
-            ok = test(q, w, mid.view(np.float64))
-            hi_bits = np.where(active & ok, mid, hi_bits)
-            lo_bits = np.where(active & ~ok, mid, lo_bits)
-        t_lo = lo_bits.view(np.float64)
+        t_lo, t_hi = float_bisection(lambda t: test(q, w, t), hi)
         # t = 0 itself may already hold (a point on the surface)
-        return np.where(test(q, w, t_lo), t_lo, hi_bits.view(np.float64))
+        return np.where(test(q, w, t_lo), t_lo, t_hi)
 

@@ -38,7 +38,7 @@ from ..octree.morton import NEIGHBOURS
 from .edges import crossings
 
 __all__ = ["distance_to_surface", "surface_points", "distance_to_mesh", "mesh_samples",
-           "hausdorff"]
+           "hausdorff", "sphere_directions"]
 
 #: steps of the ladder along each direction, and bisection steps after it
 _LADDER = 32
@@ -75,7 +75,7 @@ def distance_to_surface(func: Function, points: np.ndarray, limit: float,
     downhill = np.where((f0 > 0)[:, None], -unit, unit)     # towards the other sign
     directions = [downhill] + [np.broadcast_to(np.array(c) / np.linalg.norm(c), (n, 3))
                                   for c in NEIGHBOURS] + \
-        [np.broadcast_to(c, (n, 3)) for c in _sphere_directions(_MORE)]
+        [np.broadcast_to(c, (n, 3)) for c in sphere_directions(_MORE)]
     inside0 = f0 < 0
     for i, d in enumerate(directions):
         # the 26 only where the gradient left more than an eighth of the limit, the
@@ -109,7 +109,7 @@ def distance_to_surface(func: Function, points: np.ndarray, limit: float,
     return best
 
 
-def _sphere_directions(count: int) -> np.ndarray:
+def sphere_directions(count: int) -> np.ndarray:
     """``count`` unit vectors spread evenly over the sphere (a Fibonacci lattice)."""
     k = np.arange(count) + 0.5
     z = 1 - 2 * k / count

@@ -12,7 +12,6 @@ in the same run, the cost of the equivalent plain numpy expression. The
 from __future__ import annotations
 
 import argparse
-import os
 import sys
 import time
 
@@ -52,7 +51,7 @@ def main() -> None:
     parser.add_argument("--n", type=int, default=1_000_000)
     parser.add_argument("--repeat", type=int, default=3)
     args = parser.parse_args()
-    load = "/".join(f"{v:.2f}" for v in os.getloadavg())
+    load = tables.load_average()
     rows = []
     n = args.n
     rng = np.random.default_rng(0)

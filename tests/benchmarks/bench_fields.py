@@ -24,9 +24,7 @@ Errors are in voxels. The table goes to ``tests/benchmarks/results/fields.md``.
 from __future__ import annotations
 
 import argparse
-import json
 import os
-import resource
 import sys
 import time
 
@@ -57,10 +55,6 @@ def _shape(name: str):
     return example(name)
 
 
-def _peak() -> int:
-    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024
-
-
 def child(name: str, res: int, method: str) -> dict:
     """One run in this process: the field, or its baseline; time, peak, error."""
     import implicitvox as ivx
@@ -71,7 +65,7 @@ def child(name: str, res: int, method: str) -> dict:
         t = time.perf_counter()
         field = ivx.distance_field(shape, res, norm=norm, band=band, check_suitability=False)
         seconds = time.perf_counter() - t
-        out = {"seconds": seconds, "peak": _peak(), "samples": field.count,
+        out = {"seconds": seconds, "peak": tables.peak_bytes(), "samples": field.count,
                "kind": field.kind, "bound": field.max_error / min(field.grid.voxel_size)}
         coords, values, _ = field.band_values()
         rng = np.random.default_rng(0)
@@ -101,7 +95,7 @@ def child(name: str, res: int, method: str) -> dict:
         solid = solid_voxels(vox, shape)
         signed = ndimage.distance_transform_edt(~solid) - ndimage.distance_transform_edt(solid)
     seconds = time.perf_counter() - t
-    out = {"seconds": seconds, "peak": _peak(), "samples": int(signed.size)}
+    out = {"seconds": seconds, "peak": tables.peak_bytes(), "samples": int(signed.size)}
     cached = np.load(_cache(name, res))
     c, ours = cached["coords"], cached["values"]
     h = min(vox.grid.voxel_size)
@@ -122,11 +116,9 @@ def main() -> None:
     parser.add_argument("--quick", action="store_true", help="small resolutions (a smoke run)")
     parser.add_argument("--child", nargs=3, help=argparse.SUPPRESS)
     args = parser.parse_args()
-    if args.child:
-        name, res, method = args.child
-        print(json.dumps(child(name, int(res), method)))
+    if tables.answer_child(args.child, child):
         return
-    load = "/".join(f"{v:.2f}" for v in os.getloadavg())
+    load = tables.load_average()
     print(f"load average before: {load}")
     rows = []
     for name in args.cases:

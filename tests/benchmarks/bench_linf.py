@@ -10,7 +10,6 @@ primitive's box grown by half its size, and for the bunny also near its surface
 """
 from __future__ import annotations
 
-import os
 import sys
 import time
 from pathlib import Path
@@ -37,7 +36,7 @@ def per_point(fn, points, repeat=3) -> float:
 
 
 def main() -> None:
-    load = "/".join(f"{v:.2f}" for v in os.getloadavg())
+    load = tables.load_average()
     table = []
     rng = np.random.default_rng(0)
     q, _ = np.linalg.qr(rng.normal(size=(3, 3)))

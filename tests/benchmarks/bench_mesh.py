@@ -16,7 +16,6 @@ Prints per resolution, in the same run:
 from __future__ import annotations
 
 import argparse
-import os
 import sys
 import time
 from pathlib import Path
@@ -58,7 +57,7 @@ def main() -> None:
     parser.add_argument("--repeat", type=int, default=3)
     parser.add_argument("--no-trimesh", action="store_true", help="skip trimesh (slow)")
     args = parser.parse_args()
-    load = "/".join(f"{v:.2f}" for v in os.getloadavg())
+    load = tables.load_average()
     rows = []
     v, f = as_triangles(str(BUNNY))
     tri = v[f]

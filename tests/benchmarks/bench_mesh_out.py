@@ -24,10 +24,7 @@ and after; the table goes to ``tests/benchmarks/results/mesh_out.md``.
 from __future__ import annotations
 
 import argparse
-import json
 import math
-import os
-import resource
 import sys
 import time
 
@@ -80,7 +77,7 @@ def child(name: str, res: int, method: str) -> dict:
     else:
         m = _dense(shape, grid)
     seconds = time.perf_counter() - t
-    peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024
+    peak = tables.peak_bytes()
     h = max(grid.voxel_size)
     f = ivx.compile(shape.expr)
     rng = np.random.default_rng(0)
@@ -114,12 +111,10 @@ def main() -> None:
                         help="skip the mesher where its estimate passes this")
     parser.add_argument("--child", nargs=3, help=argparse.SUPPRESS)
     args = parser.parse_args()
-    if args.child:
-        name, res, method = args.child
-        print(json.dumps(child(name, int(res), method)))
+    if tables.answer_child(args.child, child):
         return
     from implicitvox.octree.budget import available_memory
-    load = "/".join(f"{v:.2f}" for v in os.getloadavg())
+    load = tables.load_average()
     print(f"load average before: {load}; memory available {available_memory() / 2**30:.1f} GiB")
     rows = []
     for name in args.models:

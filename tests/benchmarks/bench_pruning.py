@@ -46,7 +46,7 @@ except ImportError:        # run as a script from elsewhere
 
 
 def _load() -> str:
-    return "/".join(f"{v:.2f}" for v in os.getloadavg())
+    return tables.load_average()
 
 
 def _run(shape, res: int, prune: bool, options: dict):

@@ -21,7 +21,6 @@ The interval evaluation runs in float32 for these models at every level
 from __future__ import annotations
 
 import argparse
-import os
 import time
 
 import numpy as np
@@ -86,7 +85,7 @@ def main() -> None:
                              "its page faults)")
     args = parser.parse_args()
     resolutions = [r for r in (128, 256, 512, 1024, 2048) if r <= args.max_res]
-    load_before = "/".join(f"{v:.2f}" for v in os.getloadavg())
+    load_before = tables.load_average()
     counts: dict = {}
     speedups: dict = {}
     tight: dict = {}

@@ -52,7 +52,7 @@ def write(name: str, header: Sequence[str], rows: Sequence[Sequence[str]], comma
     """Write results file ``NAME.md``: the table, then how and where it was measured."""
     RESULTS.mkdir(exist_ok=True)
     today = datetime.date.today().isoformat()
-    load_after = "/".join(f"{v:.2f}" for v in os.getloadavg())
+    load_after = load_average()
     text = (markdown(header, rows) + f"\n`{command}`, {today}, on {machine()}; load average "
             f"{load_before} before, {load_after} after.\n")
     path = RESULTS / f"{name}.md"
@@ -60,6 +60,28 @@ def write(name: str, header: Sequence[str], rows: Sequence[Sequence[str]], comma
     print(f"wrote {path.relative_to(ROOT)}; copy it into the README with "
           f"`python -m tests.benchmarks.tables`")
     return path
+
+
+def load_average() -> str:
+    """The 1, 5 and 15 minute load averages, as the results files print them."""
+    return "/".join(f"{v:.2f}" for v in os.getloadavg())
+
+
+def peak_bytes() -> int:
+    """This process's peak resident memory (``ru_maxrss``, KiB on Linux), in bytes."""
+    import resource
+    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024
+
+
+def answer_child(case, child) -> bool:
+    """In a ``--child NAME RES METHOD`` process: run ``child(name, int(res), method)``,
+    print its JSON for :func:`run_child`, and say so (the script then returns)."""
+    if not case:
+        return False
+    import json
+    name, res, method = case
+    print(json.dumps(child(name, int(res), method)))
+    return True
 
 
 def run_child(script: str, *args: str) -> dict:

@@ -188,7 +188,7 @@ def test_reconstruction_sample_gradient_and_isosurface():
     field = iv.distance_field(ball, 32, band=3, bounds=((-1.1,) * 3, (1.1,) * 3))
     coords, values, _ = field.band_values()
     assert np.array_equal(field.sample(field.grid.centers(coords[:50])), values[:50])
-    dirs = iv.fields.errors.fibonacci_directions(40)
+    dirs = iv.meshing.hausdorff.sphere_directions(40)
     on = ball.center + 0.8 * dirs
     grad = field.gradient(on)
     cos = np.sum(grad / np.linalg.norm(grad, axis=1, keepdims=True) * dirs, axis=1)
