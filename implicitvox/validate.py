@@ -30,7 +30,7 @@ import numpy as np
 
 __all__ = ["integer", "positive_int", "int_in", "number", "positive_number", "number_in",
            "boolean", "choice", "bounds", "resolution", "voxel_size", "points",
-           "writable_path", "max_memory"]
+           "writable_path", "max_memory", "workers", "executor", "MAX_WORKERS"]
 
 _INTS = (int, np.integer)
 _NUMBERS = (int, float, np.integer, np.floating)
@@ -187,3 +187,23 @@ def max_memory(value: Any, name: str = "max_memory") -> Optional[int]:
         raise ValueError(f"{name} must be a positive number of bytes (at most 2**62), "
                          f"got {_shown(value)}")
     return int(value)
+
+
+#: the most worker processes a run may ask for (a bound before anything is started)
+MAX_WORKERS = 1024
+
+
+def workers(value: Any, name: str = "workers") -> Optional[int]:
+    """None (all the cores this process may use) or an int from 1 to :data:`MAX_WORKERS`."""
+    if value is None:
+        return None
+    return int_in(value, name, 1, MAX_WORKERS)
+
+
+def executor(value: Any, name: str = "executor") -> Any:
+    """None, a ``concurrent.futures.Executor`` (anything with ``submit``) or a
+    ``dask.distributed.Client``."""
+    if value is None or callable(getattr(value, "submit", None)):
+        return value
+    raise TypeError(f"{name} must be a concurrent.futures.Executor or a "
+                    f"dask.distributed.Client, got {type(value).__name__}")

@@ -20,6 +20,7 @@ PACKAGES = ("implicitvox", "csg")
 #: the kernel's layers, bottom first: a module may import its own layer and those below
 LAYERS = [
     ("implicitvox.validate", "implicitvox.lazy", "implicitvox.version", "implicitvox.batches"),
+    ("implicitvox.parallel",),
     ("implicitvox.expr",),
     ("implicitvox.interval",),
     ("implicitvox.eval",),

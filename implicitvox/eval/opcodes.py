@@ -48,7 +48,7 @@ from ..interval import derivatives as D
 from ..interval import kernels as I
 from ..interval.float32 import exact_in_float32, in_float32_range
 
-__all__ = ["Opcode", "OPCODES", "PERIODIC_LIMIT", "EXP_LIMIT"]
+__all__ = ["Opcode", "OPCODES", "opcode", "PERIODIC_LIMIT", "EXP_LIMIT"]
 
 #: periodic functions of larger arguments have no mpmath reference
 PERIODIC_LIMIT = 1e15
@@ -87,6 +87,16 @@ class Opcode:
     #: a branch over a box: which operand decides (min, max) or which sign (abs) can
     #: be settled by the operands' enclosures (:mod:`implicitvox.eval.pruning`)
     choice: bool = False
+
+    def __reduce__(self):
+        """Pickled by name: a tape sent to a worker process (:mod:`implicitvox.parallel`)
+        finds the same row of :data:`OPCODES` there (its kernels are lambdas)."""
+        return (opcode, (self.name,))
+
+
+def opcode(name: str) -> Opcode:
+    """The row of :data:`OPCODES` called ``name``."""
+    return OPCODES[name]
 
 
 def _un(f):

@@ -81,6 +81,9 @@ class Subdivision:
     tapes: list = field(default_factory=list)
     #: distinct pruned tapes built
     tapes_built: int = 0
+    #: with ``until_level``: the AMBIGUOUS octants reached at that level (Morton
+    #: codes, sorted), not subdivided further: the subtrees a parallel run hands out
+    pending: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=np.uint64))
 
     @property
     def surface(self) -> np.ndarray:
@@ -407,7 +410,8 @@ def subdivide(func: Function, grid: Grid, *, start: Optional[tuple[int, np.ndarr
               interior: bool = False, exact=None, progress=None, chunk: int = CHUNK,
               mean_value: bool = False, exact_voxels=None,
               recheck: float = RECHECK, guard: Optional[MemoryGuard] = None,
-              prune: bool = True, leaf_level: Optional[int] = None) -> Subdivision:
+              prune: bool = True, leaf_level: Optional[int] = None,
+              until_level: Optional[int] = None) -> Subdivision:
     """Classify octants from the root (or from ``start``) down to the voxels.
 
     Parameters
@@ -445,6 +449,12 @@ def subdivide(func: Function, grid: Grid, *, start: Optional[tuple[int, np.ndarr
     leaf_level : int, optional
         The level whose tapes :attr:`Subdivision.tapes` reports (default: the
         voxels; the voxelizer's ``subvoxel`` runs pass the coarser voxels' level).
+    until_level : int, optional
+        Stop at this level (below ``grid.depth``): the AMBIGUOUS octants reached
+        there are returned in :attr:`Subdivision.pending` instead of being
+        subdivided. Each is an independent subtree; continuing from them
+        (``start``) gives, together, exactly the serial run's voxels and
+        interior (a box's state depends on the box alone).
     """
     depth = grid.depth
     leaf_level = depth if leaf_level is None else leaf_level
@@ -477,6 +487,7 @@ def subdivide(func: Function, grid: Grid, *, start: Optional[tuple[int, np.ndarr
     single = supports_float32(base)
     voxel_dtype = level_dtype(grid, depth) if single else np.float64
     suspects: list[tuple[np.ndarray, Tape, Tape]] = []
+    held_back: list[np.ndarray] = []     # octants reaching until_level
     pending = 0
     kept = sum(len(c) for c, _ in surface)
     held = len(frontier)   # pending and interior octant keys
@@ -517,6 +528,8 @@ def subdivide(func: Function, grid: Grid, *, start: Optional[tuple[int, np.ndarr
             if level + 1 == depth:
                 surface.append((codes, at_leaf))
                 kept += len(codes)
+            elif level + 1 == until_level:
+                held_back.append(codes)
             else:
                 frontier.push(level + 1, codes, pruned, at_leaf)
                 held += len(codes)
@@ -534,7 +547,9 @@ def subdivide(func: Function, grid: Grid, *, start: Optional[tuple[int, np.ndarr
         interior={lvl: _unpack(np.sort(np.concatenate(parts)))   # Morton order: any schedule
                   for lvl, parts in sorted(interior_parts.items())},
         evaluated=evaluated, tapes=[(len(c), t) for c, t in runs],
-        tapes_built=pruner.built if pruner is not None else 0)
+        tapes_built=pruner.built if pruner is not None else 0,
+        pending=np.sort(np.concatenate(held_back)) if held_back else
+        np.zeros(0, dtype=np.uint64))
 
 
 def _by_tapes(parts: list) -> list:

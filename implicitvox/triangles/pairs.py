@@ -38,8 +38,10 @@ from ..octree.grid import Grid
 from .ranges import expand_boxes
 from .tribox import Triangles, vertex_in_box
 from .. import batches
+from ..parallel import PIECES_PER_WORKER, Job, farm
 
-__all__ = ["surface_codes", "sorted_unique", "CHUNK"]
+__all__ = ["surface_codes", "start_pairs", "run_pairs", "split_pairs", "PairsJob",
+           "sorted_unique", "CHUNK"]
 
 #: (node, triangle) pairs per chunk
 CHUNK = batches.TRIANGLE_PAIRS
@@ -183,13 +185,39 @@ def _start_pairs(tris: Triangles, grid: Grid) -> list[tuple[int, np.ndarray, np.
 
 
 def surface_codes(tris: Triangles, grid: Grid,
-                  progress: Optional[Callable[[float], Any]] = None) -> np.ndarray:
-    """Sorted unique Morton codes of the voxels whose closed boxes meet a triangle."""
+                  progress: Optional[Callable[[float], Any]] = None, *,
+                  workers: int = 1, executor: Any = None) -> np.ndarray:
+    """Sorted unique Morton codes of the voxels whose closed boxes meet a triangle.
+
+    With ``workers`` > 1 or an ``executor``, the pairs are cut into subtrees
+    (:func:`split_pairs`) and farmed out (:class:`PairsJob`); each subtree's
+    voxels are exactly the serial run's inside it, so the result is the same array.
+    """
+    stack, found = start_pairs(tris, grid)
+    if workers > 1 or executor is not None:
+        level, pieces = split_pairs(tris, grid, stack, PIECES_PER_WORKER * workers)
+        if pieces:
+            job = PairsJob(tris, grid)
+            weights = [sum(len(n) for _, n, _ in piece) for piece in pieces]
+            for _, codes in farm(job, pieces, workers=workers, executor=executor,
+                                 weights=weights, progress=progress,
+                                 what=f"voxelizing the mesh at {grid.shape}"):
+                found.append(codes)
+            stack = []
+    found.extend(run_pairs(tris, grid, stack, progress))
+    if not found:
+        return np.zeros(0, dtype=np.uint64)
+    return sorted_unique(np.concatenate(found))
+
+
+def start_pairs(tris: Triangles, grid: Grid) -> tuple[list, list[np.ndarray]]:
+    """The first pairs of every triangle (:func:`_start_pairs`), tested: a stack of
+    ``(level, nodes, tri, weight)`` above the voxels (weights: shares of the
+    work) and the codes of voxels already found."""
     starts = _start_pairs(tris, grid)
     total = sum(len(nodes) for _, nodes, _ in starts) or 1
     stack: list[tuple[int, np.ndarray, np.ndarray, float]] = []
     found: list[np.ndarray] = []
-    done = 0.0
     for level, nodes, tri in starts:
         # the start nodes only share a bounding box with their triangle: test them
         lo, hi = _boxes(grid, level, nodes)
@@ -199,9 +227,16 @@ def surface_codes(tris: Triangles, grid: Grid,
         weight = len(nodes) / total
         if level == grid.depth:
             found.append(sorted_unique(morton.encode(nodes[holds])))
-            done += weight
         else:
             _push(stack, level, nodes[holds], tri[holds], weight)
+    return stack, found
+
+
+def run_pairs(tris: Triangles, grid: Grid, stack: list,
+              progress: Optional[Callable[[float], Any]] = None) -> list[np.ndarray]:
+    """Subdivide the pairs on ``stack`` (depth first) to the voxels; the codes found."""
+    found: list[np.ndarray] = []
+    done = 1.0 - sum(weight for *_, weight in stack)
     while stack:
         level, nodes, t, weight = stack.pop()
         if level == grid.depth - 1:
@@ -215,9 +250,70 @@ def surface_codes(tris: Triangles, grid: Grid,
                 done += weight
         if progress is not None:
             progress(min(done, 1.0))
-    if not found:
-        return np.zeros(0, dtype=np.uint64)
-    return sorted_unique(np.concatenate(found))
+    return found
+
+
+def split_pairs(tris: Triangles, grid: Grid, stack: list, pieces: int
+                ) -> tuple[int, list[list[tuple[int, np.ndarray, np.ndarray]]]]:
+    """Cut the pairs on ``stack`` into at most ``pieces`` sets of whole subtrees.
+
+    The split level ``L`` is the first with at least four nodes per piece (or
+    two levels above the voxels); pairs above it are subdivided down to it
+    here (the tests the serial run makes), and every pair goes with its node's
+    ancestor at ``L``. The ancestors, in Morton order, are cut into contiguous
+    runs of about equal pair counts: each piece is a list of ``(level, nodes,
+    tri)``. Returns ``(L, pieces)``; no pieces when the grid is too shallow.
+    """
+    if grid.depth < 3 or not stack:
+        return 0, []
+    entries = [(lvl, nodes, t) for lvl, nodes, t, _ in stack]
+    level = 0
+    while level < grid.depth - 2:
+        level += 1
+        deep = [morton.encode(n >> (lvl - level)) for lvl, n, _ in entries if lvl >= level]
+        if deep and len(np.unique(np.concatenate(deep))) >= 4 * pieces:
+            break
+    expanded = []
+    for lvl, nodes, t in entries:
+        while lvl < level and len(nodes):
+            nodes, t = _children(tris, grid, lvl, nodes, t)
+            lvl += 1
+        if len(nodes):
+            expanded.append((lvl, nodes, t, morton.encode(nodes >> (lvl - level))))
+    if not expanded:
+        return level, []
+    keys = np.concatenate([a for *_, a in expanded])
+    ancestors, counts = np.unique(keys, return_counts=True)
+    # contiguous runs of ancestors with about equal pair counts
+    before = np.cumsum(counts) - counts
+    piece_of = (before * pieces) // counts.sum()
+    out: list[list] = [[] for _ in range(pieces)]
+    for lvl, nodes, t, anc in expanded:
+        piece = piece_of[np.searchsorted(ancestors, anc)]
+        order = np.argsort(piece, kind="stable")
+        piece, nodes, t = piece[order], nodes[order], t[order]
+        edges = np.searchsorted(piece, np.arange(pieces + 1))
+        for k in range(pieces):
+            if edges[k + 1] > edges[k]:
+                out[k].append((lvl, nodes[edges[k]:edges[k + 1]], t[edges[k]:edges[k + 1]]))
+    return level, [p for p in out if p]
+
+
+class PairsJob(Job):
+    """The triangles and the grid, shared by every piece of a parallel mesh voxelization."""
+
+    def __init__(self, tris: Triangles, grid: Grid):
+        super().__init__()
+        self.tris, self.grid = tris, grid
+
+    def run(self, piece: list) -> np.ndarray:
+        """The sorted codes of the voxels met in the subtrees of ``piece``
+        (a list of ``(level, nodes, tri)``)."""
+        stack: list = []
+        for level, nodes, t in piece:
+            _push(stack, level, nodes, t, 0.0)
+        found = run_pairs(self.tris, self.grid, stack)
+        return sorted_unique(np.concatenate(found)) if found else np.zeros(0, dtype=np.uint64)
 
 
 def sorted_unique(codes: np.ndarray) -> np.ndarray:

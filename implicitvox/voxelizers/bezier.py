@@ -27,7 +27,8 @@ from ..octree.store import Octree
 from ..octree.voxels import Voxels
 from ..octree.grid import grid_of
 from ..octree.budget import memory_budget, refuse_over_budget
-from .mesh import estimate_mesh_memory, nearest_triangle_normals
+from .mesh import estimate_mesh_memory, estimate_mesh_voxels, nearest_triangle_normals
+from ..parallel import plan_workers
 
 __all__ = ["voxelize_bezier", "BezierSource"]
 
@@ -36,9 +37,12 @@ class BezierSource:
     """The patches a :class:`Voxels` came from (its
     :class:`~implicitvox.octree.voxels.VoxelSource`)."""
 
-    def __init__(self, patches: list[BezierPatch], flatness: float):
+    def __init__(self, patches: list[BezierPatch], flatness: float,
+                 parallel: tuple[Optional[int], Any] = (1, None)):
         self.patches = patches
         self.flatness = flatness
+        #: ``(workers, executor)`` of the run, used again by :meth:`refine`
+        self.parallel = parallel
 
     def refine(self, voxels: Voxels, levels: int, progress: Any = None,
                max_memory: Optional[int] = None) -> Voxels:
@@ -62,7 +66,8 @@ def voxelize_bezier(patches: Union[BezierPatch, Iterable[BezierPatch]],
                     voxel_size: Union[float, tuple[float, float, float], None] = None,
                     flatness: float = 0.125,
                     progress: Optional[Callable[[float], Any]] = None,
-                    max_memory: Optional[int] = None) -> Voxels:
+                    max_memory: Optional[int] = None, workers: Optional[int] = None,
+                    executor: Any = None) -> Voxels:
     """Voxelize Bézier patches: every voxel a patch meets is output (Stolte §4.2).
 
     Parameters
@@ -85,6 +90,11 @@ def voxelize_bezier(patches: Union[BezierPatch, Iterable[BezierPatch]],
         Refuse (``MemoryError``) before voxelizing when the estimated peak
         (from the flat pieces' area) exceeds this many bytes; default half the
         available memory.
+    workers : int, optional
+        Processes to voxelize the flat pieces on (as :func:`implicitvox.voxelize_mesh`);
+        default every core this process may use, one for a small run.
+    executor : concurrent.futures.Executor or dask.distributed.Client, optional
+        Run the pieces there instead.
 
     Returns
     -------
@@ -106,16 +116,21 @@ def voxelize_bezier(patches: Union[BezierPatch, Iterable[BezierPatch]],
         own = (tuple(nets.min(0).tolist()), tuple(nets.max(0).tolist()))
     grid = grid_of(own, bounds, resolution, voxel_size, "the patches")
     metadata = {"model": f"{len(patches)} Bezier patches", "flatness": flatness}
-    return _voxelize_on(BezierSource(patches, flatness), grid, progress, metadata, budget)
+    source = BezierSource(patches, flatness, (validate.workers(workers),
+                                              validate.executor(executor)))
+    return _voxelize_on(source, grid, progress, metadata, budget)
 
 
 def _voxelize_on(source: BezierSource, grid: Grid, progress: Any, metadata: dict,
                  budget: int) -> Voxels:
     t0 = time.perf_counter()
     tri, dil = bezier_triangles(source.patches, source.flatness * np.asarray(grid.voxel_size))
-    refuse_over_budget(estimate_mesh_memory(tri, grid, False), budget,
+    workers, executor = source.parallel
+    workers = plan_workers(workers, executor, estimate_mesh_voxels(tri, grid))
+    refuse_over_budget(estimate_mesh_memory(tri, grid, False, workers), budget,
                        f"voxelizing the patches at {grid.shape}")
-    codes = surface_codes(Triangles(tri, dil), grid, progress=progress)
+    codes = surface_codes(Triangles(tri, dil), grid, progress=progress, workers=workers,
+                          executor=executor)
     tree = Octree.from_codes(codes, grid.depth, {}, presorted=True)
     metadata = dict(metadata, seconds_total=time.perf_counter() - t0)
     return Voxels(grid, tree, {}, metadata, source=source)

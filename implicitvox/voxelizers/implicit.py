@@ -21,15 +21,16 @@ from .. import batches
 from .. import validate
 from ..version import __version__
 from ..eval.function import Function
-from ..eval.gradient import evaluate_gradients
 from ..expr.shape import as_shape, exact_classifier, voxel_classifier
 from ..meshing.mesher import REFINE, mesh, mesh_grid
-from ..octree import morton
 from ..octree.morton import MAX_BITS
 from ..octree.grid import Grid, grid_of
 from ..octree.guard import MemoryGuard
 from ..octree.store import Octree
 from ..octree.subdivide import RECHECK, subdivide
+from .surface import subdivide_voxels, surface_payload, unit_vectors, voxel_normals
+from .subtrees import parallel_bytes, subdivide_in_parallel
+from ..parallel import plan_workers
 from ..octree.voxels import Voxels
 from ..octree.budget import memory_budget, refuse_over_budget
 
@@ -46,7 +47,6 @@ _BYTES_PER_BOX = 512
 #: USELESS_MIN_CELLS voxels is flagged with a warning
 USELESS_SHARE = 0.5
 USELESS_MIN_CELLS = 4096
-_NORMALS_CHUNK = batches.NORMALS
 
 
 def estimate_memory(func: Function, grid: Grid, normals: bool = False, prune: bool = True
@@ -81,42 +81,17 @@ def bytes_per_voxel(normals: bool) -> int:
     return _BYTES_PER_VOXEL + (_BYTES_PER_NORMAL if normals else 0)
 
 
-def voxel_normals(func: Function, grid: Grid, coords: np.ndarray,
-                  tapes: Optional[list] = None) -> np.ndarray:
-    """Unit gradients at voxel centres (Stolte §2), float32; zero where undefined.
-
-    ``tapes``: runs ``(count, tape)`` over ``coords`` of tapes valid over the
-    voxels (the pruned tapes :attr:`Subdivision.tapes`; the same gradients,
-    bit for bit, in fewer operations); default the function's own tape."""
-    out = np.zeros((len(coords), 3), dtype=np.float32)
-    runs = tapes if tapes is not None else [(len(coords), func.tape)]
-    start = 0
-    for count, tape in runs:
-        for s in range(start, start + count, _NORMALS_CHUNK):
-            e = min(s + _NORMALS_CHUNK, start + count)
-            c = grid.centers(coords[s:e])
-            _, g = evaluate_gradients(tape, c[:, 0], c[:, 1], c[:, 2])
-            out[s:e] = unit_vectors(g.T)
-        start += count
-    return out
-
-
-def unit_vectors(g: np.ndarray) -> np.ndarray:
-    """Rows of ``g`` (n, 3) scaled to unit length, float32; zero where the length is
-    zero or not finite."""
-    norm = np.linalg.norm(g, axis=1, keepdims=True)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        return np.where((norm > 0) & np.isfinite(norm), g / norm, 0.0).astype(np.float32)
-
-
 class ImplicitSource:
     """The shape and options a :class:`Voxels` came from (its
     :class:`~implicitvox.octree.voxels.VoxelSource`)."""
 
-    def __init__(self, shape: Any, func: Function, options: dict[str, Any]):
+    def __init__(self, shape: Any, func: Function, options: dict[str, Any],
+                 parallel: tuple[Optional[int], Any] = (1, None)):
         self.shape = shape
         self.func = func
         self.options = dict(options)
+        #: ``(workers, executor)`` of the run, used again by :meth:`refine`
+        self.parallel = parallel
 
     def refine(self, voxels: Voxels, levels: int, progress: Any = None,
                max_memory: Optional[int] = None) -> Voxels:
@@ -157,7 +132,8 @@ def voxelize(shape: Any, resolution: Union[int, tuple[int, int, int], None] = No
              interior: bool = False, normals: bool = False,
              progress: Optional[Callable[[float], Any]] = None,
              max_memory: Optional[int] = None, mean_value: bool = False,
-             subvoxel: int = 0, recheck: float = RECHECK, prune: bool = True) -> Voxels:
+             subvoxel: int = 0, recheck: float = RECHECK, prune: bool = True,
+             workers: Optional[int] = None, executor: Any = None) -> Voxels:
     """Voxelize a shape: every voxel whose closed box the surface meets is output.
 
     Interval arithmetic rejects octants the surface cannot meet and
@@ -208,6 +184,16 @@ def voxelize(shape: Any, resolution: Union[int, tuple[int, int, int], None] = No
         (:mod:`implicitvox.eval.pruning`): a union of many parts costs, near
         each voxel, about what the parts near it cost. The voxels, interior
         and normals are bit-identical with ``prune=False``.
+    workers : int, optional
+        Processes to subdivide on (Stolte §5.2,
+        :mod:`implicitvox.voxelizers.subtrees`). Default: every core this
+        process may use, or one (serial, in this process) for a run estimated
+        below :data:`implicitvox.parallel.MIN_PARALLEL_WORK` surface voxels.
+        The voxels, interior and normals are bit-identical for any number.
+    executor : concurrent.futures.Executor or dask.distributed.Client, optional
+        Run the pieces there instead (a Dask client: on its cluster;
+        ``workers`` then only sets how finely the work is cut, default the
+        cluster's threads).
 
     Returns
     -------
@@ -232,8 +218,9 @@ def voxelize(shape: Any, resolution: Union[int, tuple[int, int, int], None] = No
     if grid.depth + options["subvoxel"] > 21:
         raise ValueError(f"resolution {grid.shape} with subvoxel={subvoxel} exceeds the octree's "
                          "21 levels")
+    parallel = (validate.workers(workers), validate.executor(executor))
     func = Function(shape.expr)
-    return _run(ImplicitSource(shape, func, options), grid, progress, start=None,
+    return _run(ImplicitSource(shape, func, options, parallel), grid, progress, start=None,
                 interior_before=None, budget=budget)
 
 
@@ -243,18 +230,33 @@ def _run(source: ImplicitSource, grid: Grid, progress, start, interior_before,
     shape, func, options = source.shape, source.func, source.options
     estimated_voxels, estimated_bytes = estimate_memory(func, grid, options["normals"],
                                                         options["prune"])
+    workers, executor = source.parallel
+    workers = plan_workers(workers, executor, estimated_voxels)
+    per_voxel = bytes_per_voxel(options["normals"])
+    if workers > 1:
+        estimated_bytes = parallel_bytes(estimated_voxels, per_voxel, working_bytes(grid),
+                                         workers)
     what = f"voxelizing at {grid.shape}"
-    refuse_over_budget(estimated_bytes, budget, f"{what} (~{estimated_voxels:,} surface voxels)")
-    guard = MemoryGuard(budget, what, bytes_per_voxel(options["normals"]),
+    refuse_over_budget(estimated_bytes, budget, f"{what} (~{estimated_voxels:,} surface voxels"
+                       + (f", {workers} workers)" if workers > 1 else ")"))
+    guard = MemoryGuard(budget, what, per_voxel,
                         estimated_voxels=estimated_voxels, working=working_bytes(grid))
     t0 = time.perf_counter()
-    result = _subdivide(func, grid, options, (exact_classifier(shape), voxel_classifier(shape)),
-                        progress, start, guard)
+    split = None
+    if workers > 1 or executor is not None:
+        split = subdivide_in_parallel(shape, func, grid, options, workers=workers,
+                                      executor=executor, progress=progress, start=start,
+                                      budget=budget, per_voxel=per_voxel, guard=guard,
+                                      what=what)
+    if split is None:
+        result = subdivide_voxels(func, grid, options,
+                                  (exact_classifier(shape), voxel_classifier(shape)),
+                                  progress, start, guard)
+        payload = surface_payload(func, grid, result, options["normals"])
+    else:
+        result, payload = split
     t1 = time.perf_counter()
     _warn_if_useless(len(result.codes), grid)
-    payload = {}
-    if options["normals"]:
-        payload["normals"] = voxel_normals(func, grid, result.surface, result.tapes)
     tree = Octree.from_codes(result.codes, grid.depth, payload)
     interior = dict(interior_before or {})
     for level, coords in result.interior.items():
@@ -266,6 +268,7 @@ def _run(source: ImplicitSource, grid: Grid, progress, start, interior_before,
         "boxes_evaluated": result.evaluated,
         "tapes_built": result.tapes_built,
         "estimated_voxels": estimated_voxels,
+        "workers": workers if split is not None else 1,
         "implicitvox": __version__,
     }
     return Voxels(grid, tree, interior, metadata, source=source)
@@ -281,47 +284,3 @@ def _warn_if_useless(count: int, grid: Grid) -> None:
                       "outside (detail finer than a voxel, catastrophic cancellation, or a "
                       "scale below the float resolution); check the model's scale or the "
                       "resolution", UserWarning, stacklevel=4)
-
-
-def _subdivide(func, grid, options, exact, progress, start, guard):
-    """Subdivide on the grid, or on a finer one mapped back (``subvoxel``)."""
-    s = options["subvoxel"]
-    exact_boxes, exact_voxels = exact
-    result = subdivide(func, grid.finer(s) if s else grid, start=start,
-                       interior=options["interior"], exact=exact_boxes, progress=progress,
-                       mean_value=options["mean_value"], exact_voxels=exact_voxels,
-                       recheck=options["recheck"], guard=guard, prune=options["prune"],
-                       leaf_level=grid.depth)
-    if not s:
-        return result
-    # the voxels holding them, each with the tape of one of its sub-voxels (all have the voxel's)
-    run_of = np.repeat(np.arange(len(result.tapes)), [n for n, _ in result.tapes])
-    result.codes, first = np.unique(result.codes >> np.uint64(3 * s), return_index=True)
-    order = np.argsort(run_of[first], kind="stable")
-    result.codes = result.codes[order]
-    counts = np.bincount(run_of[first], minlength=len(result.tapes))
-    result.tapes = [(int(c), t) for c, (_, t) in zip(counts, result.tapes) if c]
-    result.interior = _interior_from_subvoxels(result.interior, grid, s)
-    return result
-
-
-def _interior_from_subvoxels(interior, grid, s):
-    """FULL octants above the voxel level stay; below it, a voxel is interior
-    when FULL sub-octants cover all of it."""
-    depth = grid.depth
-    kept = {lvl: c for lvl, c in interior.items() if lvl <= depth}
-    voxels, weights = [], []
-    for lvl, c in interior.items():
-        if lvl > depth:
-            voxels.append(c >> (lvl - depth))
-            weights.append(np.full(len(c), 8 ** (depth + s - lvl), dtype=np.int64))
-    if voxels:
-        codes = morton.encode(np.concatenate(voxels))
-        uniq, inverse = np.unique(codes, return_inverse=True)
-        covered = np.bincount(inverse, weights=np.concatenate(weights))
-        whole = uniq[covered == 8 ** s]
-        if len(whole):
-            if depth in kept:   # the union, in Morton order
-                whole = np.sort(np.concatenate([morton.encode(kept[depth]), whole]))
-            kept[depth] = morton.decode(whole).astype(np.int32)
-    return kept

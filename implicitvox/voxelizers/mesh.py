@@ -35,8 +35,10 @@ from ..octree.store import Octree
 from ..octree.voxels import Voxels
 from ..octree.grid import grid_of
 from ..octree.budget import memory_budget, refuse_over_budget
+from ..parallel import plan_workers
 
-__all__ = ["voxelize_mesh", "mesh_bounds", "MeshSource", "nearest_triangle_normals"]
+__all__ = ["voxelize_mesh", "mesh_bounds", "MeshSource", "nearest_triangle_normals",
+           "estimate_mesh_voxels", "estimate_mesh_memory"]
 
 #: bytes per surface voxel (codes, sort, octree) and per (node, triangle) pair
 _BYTES_PER_VOXEL = 40
@@ -45,10 +47,13 @@ _BYTES_PER_VOXEL = 40
 class MeshSource:
     """The triangles a :class:`Voxels` came from (so it can be refined)."""
 
-    def __init__(self, triangles: Triangles, name: str, interior: bool):
+    def __init__(self, triangles: Triangles, name: str, interior: bool,
+                 parallel: tuple[Optional[int], Any] = (1, None)):
         self.triangles = triangles
         self.name = name
         self.interior = interior
+        #: ``(workers, executor)`` of the run, used again by :meth:`refine`
+        self.parallel = parallel
 
     def refine(self, voxels: Voxels, levels: int, progress: Any = None,
                max_memory: Optional[int] = None) -> Voxels:
@@ -97,7 +102,8 @@ def voxelize_mesh(mesh: Any, resolution: Union[int, tuple[int, int, int], None] 
                   bounds: Any = None,
                   voxel_size: Union[float, tuple[float, float, float], None] = None,
                   interior: bool = False, progress: Optional[Callable[[float], Any]] = None,
-                  max_memory: Optional[int] = None) -> Voxels:
+                  max_memory: Optional[int] = None, workers: Optional[int] = None,
+                  executor: Any = None) -> Voxels:
     """Voxelize a triangle mesh: every voxel whose closed box meets a triangle, and no other.
 
     Parameters
@@ -122,6 +128,12 @@ def voxelize_mesh(mesh: Any, resolution: Union[int, tuple[int, int, int], None] 
     max_memory : int, optional
         Refuse (``MemoryError``) before starting when the estimated peak
         exceeds this many bytes; default half the available memory.
+    workers : int, optional
+        Processes to subdivide on (:func:`implicitvox.triangles.pairs.split_pairs`);
+        default every core this process may use, one for a small run. The
+        voxels are the same for any number; the interior is filled after, here.
+    executor : concurrent.futures.Executor or dask.distributed.Client, optional
+        Run the pieces there instead (as :func:`implicitvox.voxelize`).
 
     Returns
     -------
@@ -143,17 +155,21 @@ def voxelize_mesh(mesh: Any, resolution: Union[int, tuple[int, int, int], None] 
     own = mesh_bounds(vertices, faces) if bounds is None else None
     grid = grid_of(own, bounds, resolution, voxel_size, "the mesh")
     name = os.fspath(mesh) if isinstance(mesh, (str, os.PathLike)) else type(mesh).__name__
-    source = MeshSource(Triangles(vertices[faces]), name, interior)
+    source = MeshSource(Triangles(vertices[faces]), name, interior,
+                        (validate.workers(workers), validate.executor(executor)))
     metadata = {"model": f"mesh {name}: {len(vertices)} vertices, {len(faces)} triangles"}
     return _voxelize_on(source, grid, progress, metadata, budget)
 
 
 def _voxelize_on(source: MeshSource, grid: Grid, progress: Any, metadata: dict,
                  budget: int) -> Voxels:
-    refuse_over_budget(estimate_mesh_memory(source.triangles.v, grid, source.interior), budget,
-                       f"voxelizing the mesh at {grid.shape}")
+    workers, executor = source.parallel
+    workers = plan_workers(workers, executor, estimate_mesh_voxels(source.triangles.v, grid))
+    refuse_over_budget(estimate_mesh_memory(source.triangles.v, grid, source.interior, workers),
+                       budget, f"voxelizing the mesh at {grid.shape}")
     t0 = time.perf_counter()
-    codes = surface_codes(source.triangles, grid, progress=progress)
+    codes = surface_codes(source.triangles, grid, progress=progress, workers=workers,
+                          executor=executor)
     t1 = time.perf_counter()
     interior = interior_octants(grid, codes, source.triangles.v) if source.interior else {}
     tree = Octree.from_codes(codes, grid.depth, {}, presorted=True)
@@ -162,17 +178,26 @@ def _voxelize_on(source: MeshSource, grid: Grid, progress: Any, metadata: dict,
     return Voxels(grid, tree, interior, metadata, source=source)
 
 
-def estimate_mesh_memory(triangles: np.ndarray, grid: Grid, interior: bool) -> int:
-    """Peak bytes: surface voxels from the triangles' area (a plane meets at most
-    ``sqrt(3) * area / h**2`` voxels, plus a few per triangle), and the dense
-    fill when ``interior``."""
+def estimate_mesh_voxels(triangles: np.ndarray, grid: Grid) -> float:
+    """Surface voxels, from the triangles' area (a plane meets at most
+    ``sqrt(3) * area / h**2`` voxels), plus a few per triangle."""
     e1 = triangles[:, 1] - triangles[:, 0]
     e2 = triangles[:, 2] - triangles[:, 0]
     h = np.asarray(grid.voxel_size)
     # area in voxel units: scale each axis by its voxel size
     area = 0.5 * np.linalg.norm(np.cross(e1 / h, e2 / h), axis=1).sum() if len(triangles) else 0.0
-    voxels = min(1.8 * area + 8 * len(triangles), float(np.prod(grid.shape)))
+    return min(1.8 * area + 8 * len(triangles), float(np.prod(grid.shape)))
+
+
+def estimate_mesh_memory(triangles: np.ndarray, grid: Grid, interior: bool,
+                         workers: int = 1) -> int:
+    """Peak bytes: the surface voxels (:func:`estimate_mesh_voxels`), the dense
+    fill when ``interior``, and with ``workers`` each worker's copy of the
+    triangles and its share of the voxels."""
+    voxels = estimate_mesh_voxels(triangles, grid)
     need = voxels * _BYTES_PER_VOXEL + len(triangles) * 200
+    if workers > 1:
+        need += workers * (len(triangles) * 200 + 2 * voxels * _BYTES_PER_VOXEL / workers)
     if interior:
         need += float(np.prod(grid.shape)) * BYTES_PER_VOXEL
     return int(need)

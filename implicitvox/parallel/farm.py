@@ -1,0 +1,224 @@
+"""Hand a job's pieces to workers and yield their results as they complete.
+
+Three backends behind one generator, :func:`farm`:
+
+* ``workers=n`` (no executor): a ``ProcessPoolExecutor`` of ``n`` processes
+  started by ``forkserver`` (safe in a process with threads, as VTK and Dask
+  start; ``implicitvox`` is preloaded so a worker starts in milliseconds),
+  the job installed by the pool's initializer: it travels once per worker.
+* ``executor=`` a ``dask.distributed.Client``: the job is ``scatter``-ed to
+  every worker (``broadcast=True``) and each piece is a task reading it
+  there; Dask retries a piece whose worker died and then reports it
+  (``KilledWorker``).
+* ``executor=`` any other ``concurrent.futures.Executor`` (a thread pool, a
+  process pool of your own, an MPI pool): the job goes with every piece and is
+  prepared once per worker process (:func:`implicitvox.parallel.jobs.run_piece`).
+
+Pieces are submitted all at once; the executors hand them to workers as
+they free up (a queue: uneven pieces balance). A piece that fails re-raises
+its error here; a worker that dies raises :class:`WorkerError` at once
+(never a hang); an interrupt (Ctrl-C) or any error cancels the pieces not
+started and stops the workers of an own pool.
+
+Examples
+--------
+>>> from concurrent.futures import ThreadPoolExecutor
+>>> from implicitvox.parallel.jobs import Job
+>>> class Square(Job):
+...     def run(self, piece):
+...         return piece * piece
+>>> with ThreadPoolExecutor(2) as pool:
+...     sorted(farm(Square(), [1, 2, 3], executor=pool))
+[(0, 1), (1, 4), (2, 9)]
+"""
+from __future__ import annotations
+
+import multiprocessing
+from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
+from concurrent.futures.process import BrokenProcessPool
+from typing import Any, Callable, Iterator, Optional, Sequence
+
+from .jobs import Job, install, run_piece
+
+__all__ = ["farm", "WorkerError"]
+
+
+class WorkerError(RuntimeError):
+    """A worker process died (killed, out of memory, crashed) while running a piece."""
+
+
+def farm(job: Job, pieces: Sequence[Any], *, workers: int = 2, executor: Any = None,
+         weights: Optional[Sequence[float]] = None,
+         progress: Optional[Callable[[float], Any]] = None,
+         what: str = "a parallel run") -> Iterator[tuple[int, Any]]:
+    """Run ``job.run(piece)`` for every piece on workers; yield ``(index, result)``
+    as each completes (in no fixed order).
+
+    Parameters
+    ----------
+    job : Job
+        What the pieces share, sent once per worker.
+    pieces : sequence
+        Small, picklable descriptions of independent work (subtrees).
+    workers : int, default: 2
+        Processes of an own pool (ignored with ``executor``).
+    executor : concurrent.futures.Executor or dask.distributed.Client, optional
+        Where to run instead of an own pool.
+    weights : sequence of float, optional
+        Each piece's share of the work, for ``progress`` (default: equal).
+    progress : callable, optional
+        Called with the share of the weight completed, after each piece.
+    what : str
+        The run, for error messages ("voxelizing at (512, 512, 512)").
+
+    Raises
+    ------
+    WorkerError
+        A worker died; the message names the piece and the run.
+    """
+    if not len(pieces):
+        return
+    weights = [1.0] * len(pieces) if weights is None else [float(w) for w in weights]
+    total = sum(weights) or 1.0
+    if executor is None:
+        backend = _OwnPool(job, workers)
+    elif _is_dask(executor):
+        backend = _Dask(job, executor)
+    else:
+        backend = _Futures(job, executor)
+    done = 0.0
+    try:
+        pending = {backend.submit(piece): i for i, piece in enumerate(pieces)}
+        for future, index in backend.completed(pending):
+            result = backend.result(future, index, len(pieces), what)
+            done += weights[index]
+            if progress is not None:
+                progress(min(done / total, 1.0))
+            yield index, result
+    finally:
+        backend.close()
+
+
+def _is_dask(executor: Any) -> bool:
+    return type(executor).__module__.split(".")[0] == "distributed" and \
+        callable(getattr(executor, "scatter", None))
+
+
+def _died(index: int, count: int, what: str, cause: BaseException) -> WorkerError:
+    return WorkerError(f"a worker died while {what} (piece {index + 1} of {count}): "
+                       f"{type(cause).__name__}: {cause}; the run was stopped (out of memory? "
+                       "lower the resolution or the workers, or raise max_memory)")
+
+
+class _OwnPool:
+    """A process pool of this machine, the job installed once per worker."""
+
+    def __init__(self, job: Job, workers: int):
+        self.job = job
+        self.pool = ProcessPoolExecutor(max_workers=workers, mp_context=_context(),
+                                        initializer=install, initargs=(job,))
+
+    def submit(self, piece):
+        return self.pool.submit(run_piece, self.job.token, piece)
+
+    def completed(self, pending: dict) -> Iterator:
+        return _as_completed(pending)
+
+    def result(self, future, index: int, count: int, what: str):
+        try:
+            return future.result()
+        except BrokenProcessPool as err:
+            raise _died(index, count, what, err) from None
+
+    def close(self) -> None:
+        self.pool.shutdown(wait=False, cancel_futures=True)
+        # a piece still running is stopped, not waited for (Python 3.14 names this
+        # terminate_workers; before, the processes are reached through the pool)
+        terminate = getattr(self.pool, "terminate_workers", None)
+        if terminate is not None:
+            terminate()
+            return
+        for process in list((getattr(self.pool, "_processes", None) or {}).values()):
+            if process.is_alive():
+                process.terminate()
+
+
+_FORKSERVER = None
+
+
+def _context():
+    """``forkserver`` with implicitvox preloaded (``spawn`` where there is none)."""
+    global _FORKSERVER
+    if _FORKSERVER is None:
+        if "forkserver" in multiprocessing.get_all_start_methods():
+            ctx = multiprocessing.get_context("forkserver")
+            ctx.set_forkserver_preload(["implicitvox"])
+        else:
+            ctx = multiprocessing.get_context("spawn")
+        _FORKSERVER = ctx
+    return _FORKSERVER
+
+
+class _Futures:
+    """Any ``concurrent.futures.Executor``: the job goes with each piece."""
+
+    def __init__(self, job: Job, executor: Any):
+        self.job, self.executor, self.futures = job, executor, []
+
+    def submit(self, piece):
+        future = self.executor.submit(run_piece, self.job, piece)
+        self.futures.append(future)
+        return future
+
+    def completed(self, pending: dict) -> Iterator:
+        return _as_completed(pending)
+
+    def result(self, future, index: int, count: int, what: str):
+        try:
+            return future.result()
+        except BrokenProcessPool as err:
+            raise _died(index, count, what, err) from None
+
+    def close(self) -> None:
+        for future in self.futures:
+            future.cancel()
+
+
+class _Dask:
+    """A ``dask.distributed.Client``: the job scattered to every worker once."""
+
+    def __init__(self, job: Job, client: Any):
+        self.client = client
+        self.shared = client.scatter(job, broadcast=True, hash=False)
+        self.futures = []
+
+    def submit(self, piece):
+        future = self.client.submit(run_piece, self.shared, piece, pure=False)
+        self.futures.append(future)
+        return future
+
+    def completed(self, pending: dict) -> Iterator:
+        from distributed import as_completed
+        for future in as_completed(list(pending)):
+            yield future, pending[future]
+
+    def result(self, future, index: int, count: int, what: str):
+        from distributed import KilledWorker
+        try:
+            return future.result()
+        except KilledWorker as err:
+            raise _died(index, count, what, err) from None
+
+    def close(self) -> None:
+        if self.futures:
+            self.client.cancel(self.futures)
+        self.client.cancel([self.shared])
+
+
+def _as_completed(pending: dict) -> Iterator:
+    """``(future, index)`` as the futures complete."""
+    waiting = set(pending)
+    while waiting:
+        finished, waiting = wait(waiting, return_when=FIRST_COMPLETED)
+        for future in finished:
+            yield future, pending[future]

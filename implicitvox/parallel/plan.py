@@ -1,0 +1,73 @@
+"""How many workers a run uses and how its work is cut into pieces.
+
+Examples
+--------
+>>> split_evenly(10, 3)
+[(0, 4), (4, 7), (7, 10)]
+>>> plan_workers(None, None, work=10, cores=8)        # too small to pay: serial
+1
+>>> plan_workers(None, None, work=10**7, cores=8)
+8
+>>> plan_workers(3, None, work=10, cores=8)           # asked for: always
+3
+"""
+from __future__ import annotations
+
+import os
+from typing import Any, Optional
+
+__all__ = ["available_cores", "executor_workers", "plan_workers", "split_evenly",
+           "MIN_PARALLEL_WORK", "PIECES_PER_WORKER"]
+
+#: below this much work (estimated surface voxels, or triangle pairs) a run with the
+#: default ``workers=None`` stays serial: starting processes and shipping results
+#: costs more than it saves (tests/benchmarks/bench_parallel.py measures it)
+MIN_PARALLEL_WORK = 1 << 18
+#: pieces per worker: enough that uneven subtrees balance on the queue, few enough
+#: that each piece keeps full-sized batches
+PIECES_PER_WORKER = 8
+
+
+def available_cores() -> int:
+    """The cores this process may run on (its CPU affinity), at least 1."""
+    try:
+        return max(1, len(os.sched_getaffinity(0)))
+    except (AttributeError, OSError):
+        return max(1, os.cpu_count() or 1)
+
+
+def executor_workers(executor: Any) -> Optional[int]:
+    """Workers behind a ``dask.distributed.Client`` (its threads in all), or None
+    for an executor that does not say."""
+    info = getattr(executor, "scheduler_info", None)
+    if callable(info) and callable(getattr(executor, "scatter", None)):
+        workers = info().get("workers", {})
+        return max(1, sum(int(w.get("nthreads", 1)) for w in workers.values()))
+    return None
+
+
+def plan_workers(workers: Optional[int], executor: Any, work: float,
+                 cores: Optional[int] = None) -> int:
+    """Workers for a run of ``work`` units: ``workers`` if given; with an
+    executor, its workers; else every core, or 1 when ``work`` is below
+    :data:`MIN_PARALLEL_WORK`. 1 means serial, in this process."""
+    if workers is not None:
+        return workers
+    if executor is not None:
+        return executor_workers(executor) or available_cores()
+    if work < MIN_PARALLEL_WORK:
+        return 1
+    return available_cores() if cores is None else cores
+
+
+def split_evenly(n: int, parts: int) -> list[tuple[int, int]]:
+    """``[start, stop)`` ranges cutting ``range(n)`` into at most ``parts``
+    contiguous runs whose lengths differ by at most one (none empty)."""
+    parts = max(1, min(parts, n))
+    base, extra = divmod(n, parts)
+    out, start = [], 0
+    for i in range(parts):
+        stop = start + base + (i < extra)
+        out.append((start, stop))
+        start = stop
+    return out if n else []

@@ -1,0 +1,110 @@
+"""The voxelizer's subdivision: on the voxel grid or on sub-voxels, and the normals.
+
+Shared by the serial run (:mod:`implicitvox.voxelizers.implicit`) and the
+workers of a parallel one (:mod:`implicitvox.voxelizers.subtrees`), so both
+classify, map sub-voxels and compute normals with the same code.
+"""
+from __future__ import annotations
+
+from typing import Any, Optional
+
+import numpy as np
+
+from .. import batches
+from ..eval.function import Function
+from ..eval.gradient import evaluate_gradients
+from ..octree import morton
+from ..octree.grid import Grid
+from ..octree.guard import MemoryGuard
+from ..octree.subdivide import Subdivision, subdivide
+
+__all__ = ["subdivide_voxels", "interior_from_subvoxels", "voxel_normals", "unit_vectors",
+           "surface_payload"]
+
+_NORMALS_CHUNK = batches.NORMALS
+
+
+def voxel_normals(func: Function, grid: Grid, coords: np.ndarray,
+                  tapes: Optional[list] = None) -> np.ndarray:
+    """Unit gradients at voxel centres (Stolte §2), float32; zero where undefined.
+
+    ``tapes``: runs ``(count, tape)`` over ``coords`` of tapes valid over the
+    voxels (the pruned tapes :attr:`Subdivision.tapes`; the same gradients,
+    bit for bit, in fewer operations); default the function's own tape."""
+    out = np.zeros((len(coords), 3), dtype=np.float32)
+    runs = tapes if tapes is not None else [(len(coords), func.tape)]
+    start = 0
+    for count, tape in runs:
+        for s in range(start, start + count, _NORMALS_CHUNK):
+            e = min(s + _NORMALS_CHUNK, start + count)
+            c = grid.centers(coords[s:e])
+            _, g = evaluate_gradients(tape, c[:, 0], c[:, 1], c[:, 2])
+            out[s:e] = unit_vectors(g.T)
+        start += count
+    return out
+
+
+def unit_vectors(g: np.ndarray) -> np.ndarray:
+    """Rows of ``g`` (n, 3) scaled to unit length, float32; zero where the length is
+    zero or not finite."""
+    norm = np.linalg.norm(g, axis=1, keepdims=True)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return np.where((norm > 0) & np.isfinite(norm), g / norm, 0.0).astype(np.float32)
+
+
+def surface_payload(func: Function, grid: Grid, result: Subdivision, normals: bool) -> dict:
+    """The per-voxel arrays stored with ``result``'s voxels (in the order of its codes)."""
+    if not normals:
+        return {}
+    return {"normals": voxel_normals(func, grid, result.surface, result.tapes)}
+
+
+def subdivide_voxels(func: Function, grid: Grid, options: dict, exact: tuple,
+                     progress: Any = None, start: Any = None, guard: Optional[MemoryGuard] = None,
+                     until_level: Optional[int] = None) -> Subdivision:
+    """:func:`implicitvox.octree.subdivide.subdivide` with the voxelizer's
+    ``options`` on ``grid``, or on ``grid.finer(subvoxel)`` mapped back to
+    ``grid``'s voxels. ``exact``: the shape's box and voxel tests;
+    ``until_level`` (at most ``grid.depth``) stops there and returns the
+    pending subtrees (:attr:`Subdivision.pending`, levels of the grid
+    subdivided)."""
+    s = options["subvoxel"]
+    exact_boxes, exact_voxels = exact
+    result = subdivide(func, grid.finer(s) if s else grid, start=start,
+                       interior=options["interior"], exact=exact_boxes, progress=progress,
+                       mean_value=options["mean_value"], exact_voxels=exact_voxels,
+                       recheck=options["recheck"], guard=guard, prune=options["prune"],
+                       leaf_level=grid.depth, until_level=until_level)
+    if not s:
+        return result
+    # the voxels holding them, each with the tape of one of its sub-voxels (all have the voxel's)
+    run_of = np.repeat(np.arange(len(result.tapes)), [n for n, _ in result.tapes])
+    result.codes, first = np.unique(result.codes >> np.uint64(3 * s), return_index=True)
+    order = np.argsort(run_of[first], kind="stable")
+    result.codes = result.codes[order]
+    counts = np.bincount(run_of[first], minlength=len(result.tapes))
+    result.tapes = [(int(c), t) for c, (_, t) in zip(counts, result.tapes) if c]
+    result.interior = interior_from_subvoxels(result.interior, grid, s)
+    return result
+
+
+def interior_from_subvoxels(interior: dict, grid: Grid, s: int) -> dict:
+    """FULL octants above the voxel level stay; below it, a voxel is interior
+    when FULL sub-octants cover all of it."""
+    depth = grid.depth
+    kept = {lvl: c for lvl, c in interior.items() if lvl <= depth}
+    voxels, weights = [], []
+    for lvl, c in interior.items():
+        if lvl > depth:
+            voxels.append(c >> (lvl - depth))
+            weights.append(np.full(len(c), 8 ** (depth + s - lvl), dtype=np.int64))
+    if voxels:
+        codes = morton.encode(np.concatenate(voxels))
+        uniq, inverse = np.unique(codes, return_inverse=True)
+        covered = np.bincount(inverse, weights=np.concatenate(weights))
+        whole = uniq[covered == 8 ** s]
+        if len(whole):
+            if depth in kept:   # the union, in Morton order
+                whole = np.sort(np.concatenate([morton.encode(kept[depth]), whole]))
+            kept[depth] = morton.decode(whole).astype(np.int32)
+    return kept
