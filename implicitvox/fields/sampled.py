@@ -24,7 +24,6 @@ from typing import Any, Callable, Optional, Union
 import numpy as np
 
 from .. import validate
-from ..eval.function import Function
 from ..expr.nodes import Expr
 from ..expr.shape import as_shape
 from ..linf.mesh import TriangleMesh
@@ -33,10 +32,9 @@ from ..triangles.inputs import as_triangles
 from ..voxelizers.implicit import voxelize
 from ..voxelizers.mesh import voxelize_mesh
 from .bricks import BRICK, MAX_BAND, all_bricks, band_bricks, brick_coords
-from .certified import certified_distances
+from .samples import DistanceKernel, band_distances
 from .field import NORMS, DistanceField
 from .suitability import CRITICAL_RADIUS, SUITABILITY_CHECK_LIMIT, is_suitable_at, solid_voxels
-from .kernels import choose_kernel
 
 __all__ = ["distance_field", "TOLERANCE", "estimate_bytes"]
 
@@ -44,8 +42,6 @@ __all__ = ["distance_field", "TOLERANCE", "estimate_bytes"]
 TOLERANCE = 1e-3
 #: bytes per brick sample: value, error, band flag, and the working copies
 _BYTES_PER_SAMPLE = 8 + 8 + 1 + 48
-#: samples computed per call (bounded temporaries, progress steps)
-_CHUNK = 1 << 16
 #: voxels the certified search first looks within, for a field everywhere
 _FIRST_REACH = 5
 
@@ -72,7 +68,8 @@ def distance_field(shape: Any, resolution: Union[int, tuple[int, int, int], None
                    tolerance: Optional[float] = None,
                    check_suitability: bool = True,
                    progress: Optional[Callable[[float], Any]] = None,
-                   max_memory: Optional[int] = None) -> DistanceField:
+                   max_memory: Optional[int] = None, workers: Optional[int] = None,
+                   executor: Any = None) -> DistanceField:
     """Signed distances at the voxel centres within ``band`` voxels of the surface.
 
     Parameters
@@ -107,6 +104,13 @@ def distance_field(shape: Any, resolution: Union[int, tuple[int, int, int], None
     max_memory : int, optional
         Refuse (``MemoryError``) before allocating the bricks when they would
         exceed this many bytes; default half the available memory.
+    workers : int, optional
+        Processes for the voxelization and the band's samples (chunks of
+        :data:`implicitvox.fields.samples.CHUNK` points farmed out; the same
+        values and errors, bit for bit, for any number). Default: every core
+        this process may use, one for a small run.
+    executor : concurrent.futures.Executor or dask.distributed.Client, optional
+        Run them there instead (as :func:`implicitvox.voxelize`).
 
     Returns
     -------
@@ -122,6 +126,7 @@ def distance_field(shape: Any, resolution: Union[int, tuple[int, int, int], None
         reconstructed near those places are off (Bærentzen §4-§6).
     """
     norm = validate.choice(norm, "norm", NORMS)
+    workers, executor = validate.workers(workers), validate.executor(executor)
     band = None if band is None else validate.int_in(band, "band", 1, MAX_BAND)
     budget = memory_budget(max_memory)
     report = progress if progress is not None else (lambda share: None)
@@ -133,12 +138,14 @@ def distance_field(shape: Any, resolution: Union[int, tuple[int, int, int], None
         vox = voxelize_mesh((vertices, corners.reshape(-1, 3)),
                             resolution, bounds=bounds, voxel_size=voxel_size,
                             interior=mesh.closed, max_memory=budget,
-                            progress=lambda s: report(0.2 * s))
+                            progress=lambda s: report(0.2 * s), workers=workers,
+                            executor=executor)
         target = mesh
     else:
         target = as_shape(shape)
         vox = voxelize(target, resolution, bounds=bounds, voxel_size=voxel_size, interior=True,
-                       max_memory=budget, progress=lambda s: report(0.2 * s))
+                       max_memory=budget, progress=lambda s: report(0.2 * s), workers=workers,
+                       executor=executor)
     grid = vox.grid
     h = np.asarray(grid.voxel_size)
     tol = float(h.min()) * TOLERANCE if tolerance is None else \
@@ -153,22 +160,14 @@ def distance_field(shape: Any, resolution: Union[int, tuple[int, int, int], None
     reach = _FIRST_REACH if band is None else band + 1
     limit = reach * float(h.max()) * (math.sqrt(3) if norm == "euclidean" else 1.0)
 
-    compiled: list = []          # the function and the surface boxes, built on first use
-
-    def certify(points, w):
-        if not compiled:
-            compiled.extend([Function(target.expr), *_surface_boxes(vox)])
-        return certified_distances(compiled[0], points, norm, w, compiled[1], compiled[2],
-                                   limit=limit, tolerance=tol)
-
-    kernel = choose_kernel(target, norm, certify)
+    spec = DistanceKernel(target, norm, limit, tol, None)
+    if spec.kernel.kind == "certified":
+        spec.boxes = _surface_boxes(vox)
+    kernel = spec.kernel
     coords = brick_coords(keys)[active]
-    values_band = np.empty(len(coords))
-    errors_band = np.empty(len(coords))
-    for s in range(0, len(coords), _CHUNK):
-        part = slice(s, s + _CHUNK)
-        values_band[part], errors_band[part] = kernel(grid.centers(coords[part]), weights)
-        report(0.2 + 0.8 * min(1.0, (s + _CHUNK) / max(len(coords), 1)))
+    values_band, errors_band, used = band_distances(
+        spec, grid, weights, coords, workers=workers, executor=executor,
+        progress=lambda s: report(0.2 + 0.8 * s))
     field = _assemble(grid, norm, band, keys, active, values_band, errors_band, kernel.kind, vox)
     field.signed = mesh is None or mesh.closed
     field.metadata["suitable"] = _check_suitability(target, vox) if check_suitability and \
@@ -179,7 +178,7 @@ def distance_field(shape: Any, resolution: Union[int, tuple[int, int, int], None
                       f"tolerance {tol:.3g} (largest {field.max_error:.3g}): detail finer than "
                       "the refinement resolves", UserWarning, stacklevel=2)
     field.metadata.update({"seconds": time.perf_counter() - t0, "surface_voxels": vox.count,
-                           "tolerance": tol, "bricks": len(keys)})
+                           "tolerance": tol, "bricks": len(keys), "workers": used})
     report(1.0)
     return field
 

@@ -26,16 +26,18 @@ criterion at the resolution (:func:`implicitvox.suitability`).
 from __future__ import annotations
 
 import argparse
+import contextlib
 import os
 import runpy
 import sys
 import time
 import traceback
-from typing import Any, Optional, Sequence
+from typing import Any, Iterator, Optional, Sequence
 
 from .. import validate
 from ..expr.examples import EXAMPLES, example
 from ..triangles.inputs import MESH_SUFFIXES
+from ..parallel import WorkerError
 from ..octree.subdivide import RECHECK
 from ..voxelizers.implicit import voxelize
 from ..voxelizers.mesh import voxelize_mesh
@@ -164,6 +166,7 @@ def _parser() -> argparse.ArgumentParser:
     vox.add_argument("--out", help="write .npz, .vti or .binvox")
     vox.add_argument("--render", metavar="PNG", help="render a picture")
     vox.add_argument("--max-memory", type=float, metavar="GIB", help="refuse runs estimated above")
+    _parallel_options(vox)
     vox.add_argument("--quiet", action="store_true", help="no progress bar")
     vox.add_argument("--check-suitability", action="store_true",
                      help="print whether the solid is S_r-open and closed with r > sqrt(6) "
@@ -187,6 +190,7 @@ def _parser() -> argparse.ArgumentParser:
     fld.add_argument("--check-suitability", action="store_true",
                      help="print Baerentzen's suitability criterion at this resolution")
     fld.add_argument("--max-memory", type=float, metavar="GIB", help="refuse runs estimated above")
+    _parallel_options(fld)
     fld.add_argument("--quiet", action="store_true", help="no progress bar")
     msh = sub.add_parser("mesh", help="triangulate a model within a guaranteed Hausdorff "
                                       "distance")
@@ -208,8 +212,37 @@ def _parser() -> argparse.ArgumentParser:
     msh.add_argument("--out", help=f"write {', '.join(MESH_FORMATS)}")
     msh.add_argument("--render", metavar="PNG", help="render a picture (edges shown)")
     msh.add_argument("--max-memory", type=float, metavar="GIB", help="refuse runs estimated above")
+    _parallel_options(msh)
     msh.add_argument("--quiet", action="store_true", help="no progress bar")
     return parser
+
+
+def _parallel_options(command: argparse.ArgumentParser) -> None:
+    command.add_argument("--workers", type=int, metavar="N",
+                         help="processes to run on (default: every core, one for small runs)")
+    command.add_argument("--scheduler", metavar="ADDRESS",
+                         help="run on a Dask cluster (e.g. tcp://host:8786; needs "
+                              "dask.distributed)")
+
+
+@contextlib.contextmanager
+def _parallel(args: argparse.Namespace) -> Iterator[dict]:
+    """``workers`` and ``executor`` of a command: a Dask client while it runs."""
+    workers = validate.workers(args.workers, "--workers")
+    if args.scheduler is None:
+        yield {"workers": workers, "executor": None}
+        return
+    try:
+        from distributed import Client
+    except ImportError:
+        raise ModelError("--scheduler needs dask.distributed: pip install "
+                         "'implicitvox[dask]'") from None
+    try:
+        client = Client(args.scheduler, timeout=30)
+    except (OSError, TimeoutError) as err:
+        raise ModelError(f"--scheduler {args.scheduler}: cannot reach it ({err})") from None
+    with client:
+        yield {"workers": workers, "executor": client}
 
 
 def _shape(args: argparse.Namespace) -> Any:
@@ -246,8 +279,9 @@ def _mesh(args: argparse.Namespace) -> int:
     shape = _shape(args)
     bounds, max_memory = _common(args)
     bar = None if args.quiet else ProgressBar("meshing")
-    result = mesh(shape, args.tolerance, args.resolution, bounds=bounds, refine=args.refine,
-                  progress=bar, max_memory=max_memory, prune=args.prune)
+    with _parallel(args) as parallel:
+        result = mesh(shape, args.tolerance, args.resolution, bounds=bounds, refine=args.refine,
+                      progress=bar, max_memory=max_memory, prune=args.prune, **parallel)
     if bar:
         bar.close()
     data = result.field_data
@@ -295,9 +329,11 @@ def _field(args: argparse.Namespace) -> int:
     if args.check_suitability:
         _suitability(None if is_mesh else shape, args, bounds, max_memory)
     bar = None if args.quiet else ProgressBar("distances")
-    field = distance_field(shape, args.resolution, bounds=bounds, voxel_size=args.voxel_size,
-                           norm=args.norm, band=args.band or None, tolerance=args.tolerance,
-                           progress=bar, max_memory=max_memory)
+    with _parallel(args) as parallel:
+        field = distance_field(shape, args.resolution, bounds=bounds,
+                               voxel_size=args.voxel_size, norm=args.norm,
+                               band=args.band or None, tolerance=args.tolerance,
+                               progress=bar, max_memory=max_memory, **parallel)
     if bar:
         bar.close()
     h = min(field.grid.voxel_size)
@@ -328,14 +364,17 @@ def _voxelize(args: argparse.Namespace) -> int:
         if args.normals or args.mean_value or args.subvoxel:
             raise ModelError("--normals, --mean-value and --subvoxel apply to implicit models, "
                              "not to meshes")
-        vox = voxelize_mesh(args.model, args.resolution, bounds=bounds,
-                            voxel_size=args.voxel_size, interior=args.interior, progress=bar,
-                            max_memory=max_memory)
-    else:
-        vox = voxelize(shape, args.resolution, bounds=bounds, voxel_size=args.voxel_size,
-                       interior=args.interior, normals=args.normals or bool(args.render),
-                       progress=bar, max_memory=max_memory, mean_value=args.mean_value,
-                       subvoxel=args.subvoxel, recheck=args.recheck, prune=args.prune)
+    with _parallel(args) as parallel:
+        if is_mesh:
+            vox = voxelize_mesh(args.model, args.resolution, bounds=bounds,
+                                voxel_size=args.voxel_size, interior=args.interior,
+                                progress=bar, max_memory=max_memory, **parallel)
+        else:
+            vox = voxelize(shape, args.resolution, bounds=bounds, voxel_size=args.voxel_size,
+                           interior=args.interior, normals=args.normals or bool(args.render),
+                           progress=bar, max_memory=max_memory, mean_value=args.mean_value,
+                           subvoxel=args.subvoxel, recheck=args.recheck, prune=args.prune,
+                           **parallel)
     if bar:
         bar.close()
     meta = vox.metadata
@@ -367,6 +406,11 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
             traceback.print_exc()
         print(f"implicitvox: error: {err}", file=sys.stderr)
         return 2
+    except WorkerError as err:
+        if args.debug:
+            traceback.print_exc()
+        print(f"implicitvox: error: {err}", file=sys.stderr)
+        return 1
     except KeyboardInterrupt:
         print("implicitvox: interrupted", file=sys.stderr)
         return 130

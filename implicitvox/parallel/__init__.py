@@ -14,7 +14,7 @@ pool of ``n`` processes of this machine (``forkserver``); ``executor=`` takes
 any ``concurrent.futures.Executor`` or a ``dask.distributed.Client`` (Dask is
 the distributed engine; nothing here schedules or talks over a network).
 This layer knows nothing of octrees: each algorithm defines its job next to
-itself (:mod:`implicitvox.voxelizers.subtrees`, :mod:`implicitvox.triangles.pairs`,
+itself (:mod:`implicitvox.octree.subtrees`, :mod:`implicitvox.triangles.pairs`,
 ...).
 """
 from .farm import WorkerError, farm

@@ -2,10 +2,10 @@
 
 Three backends behind one generator, :func:`farm`:
 
-* ``workers=n`` (no executor): a ``ProcessPoolExecutor`` of ``n`` processes
-  started by ``forkserver`` (safe in a process with threads, as VTK and Dask
-  start; ``implicitvox`` is preloaded so a worker starts in milliseconds),
-  the job installed by the pool's initializer: it travels once per worker.
+* ``workers=n`` (no executor): a ``ProcessPoolExecutor`` of ``n`` processes,
+  forked (or, when this process runs other threads, started by a
+  ``forkserver`` with ``implicitvox`` preloaded: see :func:`pool_context`), the
+  job installed by the pool's initializer: it travels once per worker.
 * ``executor=`` a ``dask.distributed.Client``: the job is ``scatter``-ed to
   every worker (``broadcast=True``) and each piece is a task reading it
   there; Dask retries a piece whose worker died and then reports it
@@ -34,13 +34,14 @@ Examples
 from __future__ import annotations
 
 import multiprocessing
+import threading
 from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 from concurrent.futures.process import BrokenProcessPool
 from typing import Any, Callable, Iterator, Optional, Sequence
 
 from .jobs import Job, install, run_piece
 
-__all__ = ["farm", "WorkerError"]
+__all__ = ["farm", "WorkerError", "pool_context"]
 
 
 class WorkerError(RuntimeError):
@@ -74,7 +75,7 @@ def farm(job: Job, pieces: Sequence[Any], *, workers: int = 2, executor: Any = N
     Raises
     ------
     WorkerError
-        A worker died; the message names the piece and the run.
+        A worker died; the message names the run and how far it got.
     """
     if not len(pieces):
         return
@@ -89,8 +90,10 @@ def farm(job: Job, pieces: Sequence[Any], *, workers: int = 2, executor: Any = N
     done = 0.0
     try:
         pending = {backend.submit(piece): i for i, piece in enumerate(pieces)}
+        finished = 0
         for future, index in backend.completed(pending):
-            result = backend.result(future, index, len(pieces), what)
+            result = backend.result(future, finished, len(pieces), what)
+            finished += 1
             done += weights[index]
             if progress is not None:
                 progress(min(done / total, 1.0))
@@ -104,10 +107,10 @@ def _is_dask(executor: Any) -> bool:
         callable(getattr(executor, "scatter", None))
 
 
-def _died(index: int, count: int, what: str, cause: BaseException) -> WorkerError:
-    return WorkerError(f"a worker died while {what} (piece {index + 1} of {count}): "
-                       f"{type(cause).__name__}: {cause}; the run was stopped (out of memory? "
-                       "lower the resolution or the workers, or raise max_memory)")
+def _died(done: int, count: int, what: str, cause: BaseException) -> WorkerError:
+    return WorkerError(f"a worker died while {what} ({done} of {count} pieces done; "
+                       f"{type(cause).__name__}: {str(cause).rstrip('.')}); the run was "
+                       "stopped. Out of memory? Lower the resolution or the workers.")
 
 
 class _OwnPool:
@@ -115,7 +118,7 @@ class _OwnPool:
 
     def __init__(self, job: Job, workers: int):
         self.job = job
-        self.pool = ProcessPoolExecutor(max_workers=workers, mp_context=_context(),
+        self.pool = ProcessPoolExecutor(max_workers=workers, mp_context=pool_context(),
                                         initializer=install, initargs=(job,))
 
     def submit(self, piece):
@@ -124,11 +127,11 @@ class _OwnPool:
     def completed(self, pending: dict) -> Iterator:
         return _as_completed(pending)
 
-    def result(self, future, index: int, count: int, what: str):
+    def result(self, future, done: int, count: int, what: str):
         try:
             return future.result()
         except BrokenProcessPool as err:
-            raise _died(index, count, what, err) from None
+            raise _died(done, count, what, err) from None
 
     def close(self) -> None:
         self.pool.shutdown(wait=False, cancel_futures=True)
@@ -146,11 +149,19 @@ class _OwnPool:
 _FORKSERVER = None
 
 
-def _context():
-    """``forkserver`` with implicitvox preloaded (``spawn`` where there is none)."""
+def pool_context():
+    """How the pool's processes start: ``fork`` where the platform has it and this
+    process runs no other Python thread (cheap, and a script needs no ``if
+    __name__ == "__main__"`` guard); else ``forkserver`` with implicitvox
+    preloaded (a fork while another thread may hold a lock can deadlock), or
+    ``spawn`` where there is neither. The last two import the main script again
+    in each worker, so a script then needs the guard."""
     global _FORKSERVER
+    methods = multiprocessing.get_all_start_methods()
+    if "fork" in methods and threading.active_count() == 1:
+        return multiprocessing.get_context("fork")
     if _FORKSERVER is None:
-        if "forkserver" in multiprocessing.get_all_start_methods():
+        if "forkserver" in methods:
             ctx = multiprocessing.get_context("forkserver")
             ctx.set_forkserver_preload(["implicitvox"])
         else:
@@ -173,11 +184,11 @@ class _Futures:
     def completed(self, pending: dict) -> Iterator:
         return _as_completed(pending)
 
-    def result(self, future, index: int, count: int, what: str):
+    def result(self, future, done: int, count: int, what: str):
         try:
             return future.result()
         except BrokenProcessPool as err:
-            raise _died(index, count, what, err) from None
+            raise _died(done, count, what, err) from None
 
     def close(self) -> None:
         for future in self.futures:
@@ -202,12 +213,12 @@ class _Dask:
         for future in as_completed(list(pending)):
             yield future, pending[future]
 
-    def result(self, future, index: int, count: int, what: str):
+    def result(self, future, done: int, count: int, what: str):
         from distributed import KilledWorker
         try:
             return future.result()
         except KilledWorker as err:
-            raise _died(index, count, what, err) from None
+            raise _died(done, count, what, err) from None
 
     def close(self) -> None:
         if self.futures:

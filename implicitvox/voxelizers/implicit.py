@@ -28,8 +28,8 @@ from ..octree.grid import Grid, grid_of
 from ..octree.guard import MemoryGuard
 from ..octree.store import Octree
 from ..octree.subdivide import RECHECK, subdivide
-from .surface import subdivide_voxels, surface_payload, unit_vectors, voxel_normals
-from .subtrees import parallel_bytes, subdivide_in_parallel
+from ..octree.surface import subdivide_voxels, surface_payload, unit_vectors, voxel_normals
+from ..octree.subtrees import parallel_bytes, subdivide_in_parallel
 from ..parallel import plan_workers
 from ..octree.voxels import Voxels
 from ..octree.budget import memory_budget, refuse_over_budget
@@ -186,7 +186,7 @@ def voxelize(shape: Any, resolution: Union[int, tuple[int, int, int], None] = No
         and normals are bit-identical with ``prune=False``.
     workers : int, optional
         Processes to subdivide on (Stolte §5.2,
-        :mod:`implicitvox.voxelizers.subtrees`). Default: every core this
+        :mod:`implicitvox.octree.subtrees`). Default: every core this
         process may use, or one (serial, in this process) for a run estimated
         below :data:`implicitvox.parallel.MIN_PARALLEL_WORK` surface voxels.
         The voxels, interior and normals are bit-identical for any number.

@@ -5,7 +5,8 @@ subtrees to workers, which subdivide them to the voxels; the master merges
 what they found. Here:
 
 1. The master runs the subdivision down to a split level where the
-   AMBIGUOUS octants number at least :data:`OCTANTS_PER_PIECE` per piece
+   AMBIGUOUS octants number at least :data:`OCTANTS_PER_PIECE` per piece (or
+   :data:`MIN_LEVELS_BELOW` levels above the voxels)
    (``until_level``, :class:`~implicitvox.octree.subdivide.Subdivision`
    ``.pending``), keeping the FULL octants it met on the way.
 2. Those octants, in Morton order, are cut into contiguous runs
@@ -14,7 +15,7 @@ what they found. Here:
    (:func:`implicitvox.parallel.farm`). The shape, its compiled tape, the grid
    and the options travel once per worker (a :class:`SubtreeJob`).
 3. Each worker continues the subdivision from its octants
-   (:func:`~implicitvox.voxelizers.surface.subdivide_voxels` with ``start``),
+   (:func:`~implicitvox.octree.surface.subdivide_voxels` with ``start``),
    maps sub-voxels back, computes the normals of its voxels, and returns its
    surface voxels (Morton codes), their normals and its FULL octants.
 4. The master merges each result as it arrives (the workers' working arrays
@@ -35,10 +36,10 @@ import numpy as np
 
 from ..eval.function import Function
 from ..expr.shape import exact_classifier, voxel_classifier
-from ..octree import morton
-from ..octree.grid import Grid
-from ..octree.guard import MemoryGuard
-from ..octree.subdivide import Subdivision
+from . import morton
+from .grid import Grid
+from .guard import MemoryGuard
+from .subdivide import Subdivision
 from ..parallel import PIECES_PER_WORKER, Job, farm, split_evenly
 from .surface import subdivide_voxels, surface_payload
 
@@ -111,8 +112,7 @@ def subdivide_in_parallel(shape: Any, func: Function, grid: Grid, options: dict,
     payload, computed by ``workers`` processes or ``executor``.
 
     Returns None when the octree is too shallow to split (fewer than
-    :data:`MIN_LEVELS_BELOW` levels below a useful split level): the caller
-    runs serially. ``start``: continue from these octants (``Voxels.refine``),
+    :data:`MIN_LEVELS_BELOW` levels below level 1): the caller runs serially. ``start``: continue from these octants (``Voxels.refine``),
     which are then the pieces. ``guard`` watches the master's holdings as the
     results arrive; each worker has its own, of ``budget / (workers + 1)`` at
     ``per_voxel`` bytes per voxel kept.
@@ -126,16 +126,18 @@ def subdivide_in_parallel(shape: Any, func: Function, grid: Grid, options: dict,
         level, pending = start[0], morton.encode(start[1])
     else:
         level, pending = 0, None
+        deepest = min(grid.depth, depth - MIN_LEVELS_BELOW)
+        if deepest < 1:
+            return None
         while True:
             level += 1
-            if depth - level < MIN_LEVELS_BELOW or level > grid.depth:
-                return None
             head = subdivide_voxels(func, grid, options, exact, guard=guard, until_level=level,
                                     start=None if pending is None else
                                     (level - 1, morton.decode(pending).astype(np.int32)))
             heads.append(head)
             pending = head.pending
-            if len(pending) >= OCTANTS_PER_PIECE * pieces_wanted or not len(pending):
+            if len(pending) >= OCTANTS_PER_PIECE * pieces_wanted or not len(pending) \
+                    or level == deepest:
                 break
     ranges = split_evenly(len(pending), pieces_wanted)
     job = SubtreeJob(shape, func, grid, options, level, budget // (workers + 1), per_voxel, what)

@@ -1,7 +1,7 @@
 """The voxelizer's subdivision: on the voxel grid or on sub-voxels, and the normals.
 
 Shared by the serial run (:mod:`implicitvox.voxelizers.implicit`) and the
-workers of a parallel one (:mod:`implicitvox.voxelizers.subtrees`), so both
+workers of a parallel one (:mod:`implicitvox.octree.subtrees`), so both
 classify, map sub-voxels and compute normals with the same code.
 """
 from __future__ import annotations
@@ -13,10 +13,10 @@ import numpy as np
 from .. import batches
 from ..eval.function import Function
 from ..eval.gradient import evaluate_gradients
-from ..octree import morton
-from ..octree.grid import Grid
-from ..octree.guard import MemoryGuard
-from ..octree.subdivide import Subdivision, subdivide
+from . import morton
+from .grid import Grid
+from .guard import MemoryGuard
+from .subdivide import Subdivision, subdivide
 
 __all__ = ["subdivide_voxels", "interior_from_subvoxels", "voxel_normals", "unit_vectors",
            "surface_payload"]

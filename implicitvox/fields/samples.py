@@ -1,0 +1,100 @@
+"""The band's samples computed in chunks, here or on workers (Stolte §5.2's farm).
+
+A :class:`DistanceKernel` names everything a kernel needs (the shape, the norm,
+the certified search's boxes and limits) and builds it where it runs, once;
+:func:`band_distances` runs it over the samples in chunks of :data:`CHUNK`
+points (by kernel kind), serially or farmed out (:func:`implicitvox.parallel.farm`), the
+chunks the same either way, so the values and errors are bit-identical for
+any number of workers.
+"""
+from __future__ import annotations
+
+import functools
+from typing import Any, Callable, Optional
+
+import numpy as np
+
+from ..eval.function import Function
+from ..octree.grid import Grid
+from ..parallel import Job, farm, plan_workers
+from .certified import certified_distances
+from .kernels import Kernel, choose_kernel
+
+__all__ = ["DistanceKernel", "SamplesJob", "band_distances", "CHUNK", "COST"]
+
+#: samples computed per call, by kernel kind (bounded temporaries, progress steps,
+#: one farmed piece: a certified search takes about a millisecond per sample, so its
+#: pieces are small enough for the queue to balance)
+CHUNK = {"exact": 1 << 16, "box test": 1 << 14, "certified": 1 << 11}
+#: cost of one sample, in surface voxels of the voxelizer (for ``workers=None``'s
+#: "does it pay"): analytic distances, a hierarchy walk or box-test bisection,
+#: a certified search
+COST = {"exact": 4, "box test": 32, "certified": 512}
+
+
+class DistanceKernel:
+    """The distance kernel of a field, rebuilt wherever it runs (picklable)."""
+
+    def __init__(self, target: Any, norm: str, limit: float, tolerance: float,
+                 boxes: Optional[tuple[np.ndarray, np.ndarray]]):
+        self.target, self.norm, self.limit, self.tolerance = target, norm, limit, tolerance
+        #: the surface voxels' boxes (lo, hi), for the certified search
+        self.boxes = boxes
+
+    @functools.cached_property
+    def kernel(self) -> Kernel:
+        """:func:`~implicitvox.fields.kernels.choose_kernel`'s kernel for the target."""
+        return choose_kernel(self.target, self.norm, self._certify)
+
+    def _certify(self, points: np.ndarray, weights: Any):
+        func = _compiled(self)
+        return certified_distances(func, points, self.norm, weights, self.boxes[0],
+                                   self.boxes[1], limit=self.limit, tolerance=self.tolerance)
+
+    def __getstate__(self) -> dict:
+        return {k: v for k, v in self.__dict__.items() if k not in ("kernel", "function")}
+
+
+def _compiled(spec: DistanceKernel) -> Function:
+    if "function" not in spec.__dict__:
+        spec.__dict__["function"] = Function(spec.target.expr)
+    return spec.__dict__["function"]
+
+
+class SamplesJob(Job):
+    """A field's kernel and grid, shared by every chunk of samples."""
+
+    def __init__(self, spec: DistanceKernel, grid: Grid, weights: np.ndarray):
+        super().__init__()
+        self.spec, self.grid, self.weights = spec, grid, weights
+
+    def run(self, coords: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Values and errors at the centres of voxels ``coords`` (n, 3)."""
+        return self.spec.kernel(self.grid.centers(coords), self.weights)
+
+
+def band_distances(spec: DistanceKernel, grid: Grid, weights: np.ndarray, coords: np.ndarray,
+                   *, workers: Optional[int] = None, executor: Any = None,
+                   progress: Optional[Callable[[float], Any]] = None
+                   ) -> tuple[np.ndarray, np.ndarray, int]:
+    """Values and errors at the centres of voxels ``coords`` (n, 3), and the
+    workers used (1: serial, here)."""
+    values = np.empty(len(coords))
+    errors = np.empty(len(coords))
+    chunk = CHUNK[spec.kernel.kind]
+    starts = range(0, len(coords), chunk)
+    n = plan_workers(workers, executor, len(coords) * COST[spec.kernel.kind])
+    if (n > 1 or executor is not None) and len(starts) > 1:
+        job = SamplesJob(spec, grid, weights)
+        for i, (v, e) in farm(job, [coords[s:s + chunk] for s in starts], workers=n,
+                              executor=executor, progress=progress,
+                              weights=[min(chunk, len(coords) - s) for s in starts],
+                              what=f"computing distances at {grid.shape}"):
+            values[starts[i]:starts[i] + chunk], errors[starts[i]:starts[i] + chunk] = v, e
+        return values, errors, n
+    for s in starts:
+        part = slice(s, s + chunk)
+        values[part], errors[part] = spec.kernel(grid.centers(coords[part]), weights)
+        if progress is not None:
+            progress(min(1.0, (s + chunk) / max(len(coords), 1)))
+    return values, errors, 1

@@ -1,0 +1,246 @@
+"""Parallel runs (issue 21): bit-identical to the serial run for any number of workers,
+any schedule and any executor; a dead worker is reported; Ctrl-C stops everything."""
+from __future__ import annotations
+
+import hashlib
+import os
+import random
+import signal
+import subprocess
+import sys
+import textwrap
+import time
+from concurrent.futures import ThreadPoolExecutor
+
+import numpy as np
+import pytest
+
+import csg
+import implicitvox as iv
+from implicitvox.expr import examples
+from implicitvox.parallel import Job, WorkerError, farm, plan_workers, split_evenly
+from implicitvox.octree.subtrees import subdivide_in_parallel
+
+HERE = os.path.dirname(__file__)
+FIXTURES = os.path.join(HERE, "..", "openscad")
+BUNNY = os.path.join(HERE, "..", "..", "..", "shared", "data", "meshes", "stanford-bunny.obj")
+
+
+def digest(vox) -> str:
+    """Voxels, interior octants (per level, in order) and normals, hashed."""
+    h = hashlib.sha256(np.ascontiguousarray(vox.coords()).tobytes())
+    for level in sorted(vox.interior):
+        h.update(f"{level}:".encode() + np.ascontiguousarray(vox.interior[level]).tobytes())
+    if vox.normals is not None:
+        h.update(np.ascontiguousarray(vox.normals).tobytes())
+    return h.hexdigest()
+
+
+MODELS = {
+    "sinsin34": (examples.example("sinsin34"), {"interior": True, "normals": True}),
+    "menger": (examples.example("menger"), {"interior": True}),
+    "torus-sweep": (examples.example("torus-sweep"), {"normals": True, "subvoxel": 1}),
+    "gear": (examples.example("gear"), {"mean_value": True, "interior": True}),
+    "csg": (csg.Box((2, 2, 1)) - csg.Cylinder(0.4, 2).translate((0.3, 0, -0.5)),
+            {"interior": True, "normals": True}),
+}
+
+
+@pytest.mark.parametrize("name", sorted(MODELS))
+def test_workers_give_the_serial_voxels(name):
+    shape, options = MODELS[name]
+    serial = iv.voxelize(shape, 48, workers=1, **options)
+    assert serial.metadata["workers"] == 1
+    for n in (2, 3):
+        vox = iv.voxelize(shape, 48, workers=n, **options)
+        assert vox.metadata["workers"] == n
+        assert digest(vox) == digest(serial), (name, n)
+        assert vox.metadata["boxes_evaluated"] == serial.metadata["boxes_evaluated"]
+
+
+class _Shuffled(ThreadPoolExecutor):
+    """Threads that finish the pieces in a random order (each sleeps a random while)."""
+
+    def __init__(self, seed: int):
+        super().__init__(4)
+        self.rng = random.Random(seed)
+
+    def submit(self, fn, *args, **kwargs):
+        delay = self.rng.random() * 0.02
+
+        def late():
+            time.sleep(delay)
+            return fn(*args, **kwargs)
+        return super().submit(late)
+
+
+@pytest.mark.parametrize("seed", [1, 2])
+def test_any_schedule_gives_the_serial_voxels(seed):
+    shape = examples.example("blobby")
+    serial = iv.voxelize(shape, 40, interior=True, normals=True, workers=1)
+    with _Shuffled(seed) as pool:
+        vox = iv.voxelize(shape, 40, interior=True, normals=True, executor=pool)
+    assert digest(vox) == digest(serial)
+
+
+def test_refine_in_parallel():
+    """Voxels.refine reuses the run's workers, and matches the serial refine."""
+    shape = examples.example("sinsin34")
+    serial = iv.voxelize(shape, 32, interior=True, normals=True, workers=1).refine(1)
+    refined = iv.voxelize(shape, 32, interior=True, normals=True, workers=2).refine(1)
+    assert refined.metadata["workers"] == 2
+    assert digest(refined) == digest(serial)
+
+
+def test_meshes_and_patches_give_the_serial_voxels():
+    serial = iv.voxelize_mesh(BUNNY, 64, workers=1)
+    for n in (2, 3):
+        assert np.array_equal(iv.voxelize_mesh(BUNNY, 64, workers=n).coords(), serial.coords())
+    teapot = iv.voxelize_bezier(iv.utah_teapot(), 48, workers=1)
+    assert np.array_equal(iv.voxelize_bezier(iv.utah_teapot(), 48, workers=2).coords(),
+                          teapot.coords())
+
+
+def test_openscad_model_in_parallel():
+    solid = csg.read_openscad(os.path.join(FIXTURES, "bracket.csg"))
+    serial = iv.voxelize(solid, 48, interior=True, workers=1)
+    assert digest(iv.voxelize(solid, 48, interior=True, workers=2)) == digest(serial)
+
+
+def test_dask_local_cluster_gives_the_serial_voxels():
+    distributed = pytest.importorskip("distributed", reason="dask.distributed is an extra")
+    shape = examples.example("sinsin34")
+    serial = iv.voxelize(shape, 48, interior=True, normals=True, workers=1)
+    mesh_serial = iv.voxelize_mesh(BUNNY, 48, workers=1)
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
+                                  dashboard_address=None) as cluster, \
+            distributed.Client(cluster) as client:
+        vox = iv.voxelize(shape, 48, interior=True, normals=True, executor=client)
+        assert vox.metadata["workers"] == 2
+        assert digest(vox) == digest(serial)
+        mesh_vox = iv.voxelize_mesh(BUNNY, 48, executor=client)
+        assert np.array_equal(mesh_vox.coords(), mesh_serial.coords())
+
+
+def test_too_shallow_to_split_runs_serially():
+    shape = examples.example("sphere")
+    vox = iv.voxelize(shape, 4, workers=2)
+    assert vox.metadata["workers"] == 1 and vox.count > 0
+
+
+class Crash(Job):
+    """Kills the worker process running piece 1."""
+
+    def run(self, piece):
+        if piece == 1:
+            os._exit(3)
+        time.sleep(0.05)
+        return piece
+
+
+def test_a_dead_worker_is_reported_not_waited_for():
+    t0 = time.perf_counter()
+    with pytest.raises(WorkerError, match=r"a worker died while testing \([0-3] of 4 pieces done"):
+        list(farm(Crash(), [0, 1, 2, 3], workers=2, what="testing"))
+    assert time.perf_counter() - t0 < 30
+
+
+class Fail(Job):
+    def run(self, piece):
+        raise ValueError(f"piece {piece} is bad")
+
+
+def test_an_error_in_a_piece_is_raised_as_itself():
+    with pytest.raises(ValueError, match="piece 0 is bad"):
+        list(farm(Fail(), [0], workers=2))
+
+
+def test_ctrl_c_stops_the_master_and_every_worker(tmp_path):
+    """SIGINT to the master alone (the hard case: the workers do not get it): it
+    stops at once and leaves no process of its group behind."""
+    script = tmp_path / "run.py"
+    script.write_text(textwrap.dedent("""
+        import sys, implicitvox as iv
+        from implicitvox.expr import examples
+        def tell(share):
+            print("progress", flush=True)
+        iv.voxelize(examples.example("sinsin918"), 1024, workers=2, progress=tell)
+    """))
+    child = subprocess.Popen([sys.executable, str(script)], stdout=subprocess.PIPE,
+                             stderr=subprocess.PIPE, text=True, start_new_session=True)
+    try:
+        assert child.stdout.readline().strip() == "progress"
+        time.sleep(0.5)
+        child.send_signal(signal.SIGINT)
+        _, err = child.communicate(timeout=30)
+    finally:
+        if child.poll() is None:
+            os.killpg(child.pid, signal.SIGKILL)
+    assert "KeyboardInterrupt" in err
+    deadline = time.time() + 15
+    while time.time() < deadline:
+        try:
+            os.killpg(child.pid, 0)          # anything left of the run's process group?
+        except ProcessLookupError:
+            break
+        time.sleep(0.2)
+    else:
+        os.killpg(child.pid, signal.SIGKILL)
+        pytest.fail("worker processes outlived the interrupted run")
+
+
+def test_plan_and_split():
+    assert plan_workers(None, None, work=1, cores=4) == 1
+    assert plan_workers(None, None, work=1e9, cores=4) == 4
+    assert plan_workers(2, None, work=1) == 2
+    assert split_evenly(7, 3) == [(0, 3), (3, 5), (5, 7)]
+    assert split_evenly(2, 5) == [(0, 1), (1, 2)]
+    assert split_evenly(0, 5) == []
+
+
+@pytest.mark.parametrize("bad, error, match", [
+    ({"workers": 0}, ValueError, "workers must be an int from 1 to 1024, got int 0"),
+    ({"workers": 2.5}, ValueError, "workers must be an int"),
+    ({"executor": "dask"}, TypeError, "executor must be a concurrent.futures.Executor"),
+])
+def test_bad_parallel_options_are_named(bad, error, match):
+    with pytest.raises(error, match=match):
+        iv.voxelize(examples.example("sphere"), 8, **bad)
+    with pytest.raises(error, match=match):
+        iv.voxelize_mesh(BUNNY, 8, **bad)
+
+
+def test_head_and_pieces_cover_the_serial_run():
+    """The split level's octants, subdivided apart, give the serial voxels."""
+    from implicitvox.eval.function import Function
+    from implicitvox.octree.grid import Grid
+    shape = examples.example("gear")
+    grid = Grid.from_bounds(shape.bounds, 64)
+    options = {"interior": True, "normals": False, "mean_value": False, "subvoxel": 0,
+               "recheck": 0.25, "prune": True}
+    with ThreadPoolExecutor(2) as pool:
+        result, _ = subdivide_in_parallel(shape, Function(shape.expr), grid, options,
+                                          workers=3, executor=pool, budget=1 << 30,
+                                          per_voxel=48)
+    serial = iv.voxelize(shape, bounds=grid.bounds, voxel_size=grid.voxel_size[0],
+                         interior=True, workers=1)
+    assert np.array_equal(np.sort(result.codes), np.sort(
+        iv.octree.morton.encode(serial.coords())))
+
+
+def test_forkserver_when_other_threads_run():
+    """With another thread alive a fork could deadlock: the pool starts its processes
+    through the forkserver instead, with the same result."""
+    import threading
+    from implicitvox.parallel.farm import pool_context
+    stop = threading.Event()
+    thread = threading.Thread(target=stop.wait)
+    thread.start()
+    try:
+        assert pool_context().get_start_method() in ("forkserver", "spawn")
+        shape = examples.example("gear")
+        assert digest(iv.voxelize(shape, 40, interior=True, workers=2)) == \
+            digest(iv.voxelize(shape, 40, interior=True, workers=1))
+    finally:
+        stop.set()
+        thread.join()
