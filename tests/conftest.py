@@ -3,12 +3,19 @@
 Locally, hypothesis draws new examples each run (and keeps failures in its
 database); with ``CI`` set, the ``ci`` profile derandomizes, so a CI run
 executes a fixed, reproducible set of examples and cannot flake.
+
+pytest-xdist runs one test per core already, so runs that do not ask for
+workers stay serial (``IMPLICITVOX_WORKERS=1``, the default a user sets the
+same way); the parallel tests ask for theirs (``tests/parallel``), and one
+checks the default itself.
 """
 from __future__ import annotations
 
 import os
 
 from hypothesis import settings
+
+os.environ.setdefault("IMPLICITVOX_WORKERS", "1")
 
 settings.register_profile("ci", derandomize=True, deadline=None, print_blob=True)
 if os.environ.get("CI"):

@@ -3,7 +3,7 @@
 A :class:`DistanceKernel` names everything a kernel needs (the shape, the norm,
 the certified search's boxes and limits) and builds it where it runs, once;
 :func:`band_distances` runs it over the samples in chunks of :data:`CHUNK`
-points (by kernel kind), serially or farmed out (:func:`implicitvox.parallel.farm`), the
+points (by the kernel's cost), serially or farmed out (:func:`implicitvox.parallel.farm`), the
 chunks the same either way, so the values and errors are bit-identical for
 any number of workers.
 """
@@ -15,6 +15,7 @@ from typing import Any, Callable, Optional
 import numpy as np
 
 from ..eval.function import Function
+from ..linf.mesh import TriangleMesh
 from ..octree.grid import Grid
 from ..parallel import Job, farm, plan_workers
 from .certified import certified_distances
@@ -22,14 +23,15 @@ from .kernels import Kernel, choose_kernel
 
 __all__ = ["DistanceKernel", "SamplesJob", "band_distances", "CHUNK", "COST"]
 
-#: samples computed per call, by kernel kind (bounded temporaries, progress steps,
-#: one farmed piece: a certified search takes about a millisecond per sample, so its
-#: pieces are small enough for the queue to balance)
-CHUNK = {"exact": 1 << 16, "box test": 1 << 14, "certified": 1 << 11}
+#: samples computed per call, by the kernel's cost (:attr:`DistanceKernel.cost`):
+#: bounded temporaries, progress steps, one farmed piece (a certified search takes
+#: about a millisecond per sample, so its pieces are small enough for the queue to
+#: balance)
+CHUNK = {"analytic": 1 << 16, "mesh": 1 << 14, "box test": 1 << 14, "certified": 1 << 11}
 #: cost of one sample, in surface voxels of the voxelizer (for ``workers=None``'s
-#: "does it pay"): analytic distances, a hierarchy walk or box-test bisection,
+#: "does it pay"): analytic distances, a hierarchy walk, a box-test bisection,
 #: a certified search
-COST = {"exact": 4, "box test": 32, "certified": 512}
+COST = {"analytic": 4, "mesh": 32, "box test": 32, "certified": 512}
 
 
 class DistanceKernel:
@@ -40,6 +42,14 @@ class DistanceKernel:
         self.target, self.norm, self.limit, self.tolerance = target, norm, limit, tolerance
         #: the surface voxels' boxes (lo, hi), for the certified search
         self.boxes = boxes
+
+    @property
+    def cost(self) -> str:
+        """The kernel's cost class: a key of :data:`COST` and :data:`CHUNK`."""
+        kind = self.kernel.kind
+        if kind == "exact":
+            return "mesh" if isinstance(self.target, TriangleMesh) else "analytic"
+        return kind
 
     @functools.cached_property
     def kernel(self) -> Kernel:
@@ -81,9 +91,9 @@ def band_distances(spec: DistanceKernel, grid: Grid, weights: np.ndarray, coords
     workers used (1: serial, here)."""
     values = np.empty(len(coords))
     errors = np.empty(len(coords))
-    chunk = CHUNK[spec.kernel.kind]
+    chunk = CHUNK[spec.cost]
     starts = range(0, len(coords), chunk)
-    n = plan_workers(workers, executor, len(coords) * COST[spec.kernel.kind])
+    n = plan_workers(workers, executor, len(coords) * COST[spec.cost])
     if (n > 1 or executor is not None) and len(starts) > 1:
         job = SamplesJob(spec, grid, weights)
         for i, (v, e) in farm(job, [coords[s:s + chunk] for s in starts], workers=n,

@@ -65,7 +65,7 @@ from ..octree.grid import Grid
 from ..octree.guard import MemoryGuard
 from ..octree import morton
 from ..octree.morton import CORNERS, NEIGHBOURS
-from ..octree.subdivide import classify, subdivide
+from ..octree.subdivide import Subdivision, classify, subdivide
 from ..expr.shape import AMBIGUOUS
 
 __all__ = ["AdaptiveGrid", "adaptive_grid", "corner_values", "per_tape", "BYTES_PER_CELL"]
@@ -332,7 +332,8 @@ def _beside(cells: np.ndarray, split: np.ndarray) -> np.ndarray:
 def adaptive_grid(func: Function, grid: Grid, refine: int, *,
                   exact: Optional[Callable] = None, exact_voxels: Optional[Callable] = None,
                   progress: Optional[Callable[[float], Any]] = None,
-                  guard: Optional[MemoryGuard] = None, prune: bool = True) -> AdaptiveGrid:
+                  guard: Optional[MemoryGuard] = None, prune: bool = True,
+                  voxels: Optional[Subdivision] = None) -> AdaptiveGrid:
     """Build the adaptive grid of the module docstring.
 
     Parameters
@@ -352,6 +353,11 @@ def adaptive_grid(func: Function, grid: Grid, refine: int, *,
         Asked with the cells kept after every level.
     prune : bool, default: True
         Prune the tapes of the voxelization down to the tolerance level.
+    voxels : Subdivision, optional
+        That voxelization, done already (by workers:
+        :func:`implicitvox.octree.subtrees.subdivide_in_parallel`, with its tapes).
+        Its voxels are taken in Morton order, so the leaves, and the mesh, do
+        not depend on the order the subdivision found them in.
 
     Examples
     --------
@@ -367,12 +373,15 @@ def adaptive_grid(func: Function, grid: Grid, refine: int, *,
     fine = grid.finer(refine)
     depth = top + refine
     share = (lambda s: progress(s)) if progress is not None else (lambda s: None)
-    voxels = subdivide(func, grid, exact=exact, exact_voxels=exact_voxels, guard=guard,
-                       prune=prune, progress=(lambda s: share(0.6 * s)))
-    cells = voxels.surface.astype(np.int64)
+    if voxels is None:
+        voxels = subdivide(func, grid, exact=exact, exact_voxels=exact_voxels, guard=guard,
+                           prune=prune, progress=(lambda s: share(0.6 * s)))
     tapes = [t for _, t in voxels.tapes] or [func.tape]
     tid = np.repeat(np.arange(len(voxels.tapes)), [n for n, _ in voxels.tapes]) \
-        if voxels.tapes else np.zeros(len(cells), dtype=np.int64)
+        if voxels.tapes else np.zeros(len(voxels.codes), dtype=np.int64)
+    order = np.argsort(voxels.codes, kind="stable")
+    cells = morton.decode(voxels.codes[order]).astype(np.int64)
+    tid = tid[order]
     kept: dict[str, list] = {k: [] for k in ("levels", "coords", "corners", "simple",
                                              "complex", "tid")}
     evaluated = 0

@@ -30,7 +30,9 @@ from ..octree.budget import memory_budget, refuse_over_budget
 from ..octree.grid import Grid, grid_of
 from ..octree.guard import MemoryGuard
 from ..octree.morton import MAX_BITS
-from ..octree.subdivide import subdivide
+from ..octree.subdivide import RECHECK, subdivide
+from ..octree.subtrees import subdivide_in_parallel
+from ..parallel import plan_workers
 from ..version import __version__
 from .adaptive import BYTES_PER_CELL, adaptive_grid
 from .contour import dual_contour
@@ -50,7 +52,8 @@ _LEAVES_PER_VOXEL = 2
 def mesh(shape: Any, tolerance: Optional[float] = None,
          resolution: Union[int, tuple[int, int, int], None] = None, *, bounds: Any = None,
          refine: int = REFINE, progress: Optional[Callable[[float], Any]] = None,
-         max_memory: Optional[int] = None, prune: bool = True) -> Any:
+         max_memory: Optional[int] = None, prune: bool = True,
+         workers: Optional[int] = None, executor: Any = None) -> Any:
     """Triangulate a shape's surface within a guaranteed Hausdorff distance.
 
     Parameters
@@ -78,6 +81,14 @@ def mesh(shape: Any, tolerance: Optional[float] = None,
         and stop when the run does; default half the available memory.
     prune : bool, default: True
         Prune the tapes while voxelizing (:func:`implicitvox.voxelize`).
+    workers : int, optional
+        Processes for the subdivision down to the largest cells
+        (:func:`implicitvox.octree.subtrees.subdivide_in_parallel`); the
+        refinement and the contouring run here. The mesh is the same, bit for
+        bit, for any number. Default: every core this process may use, one for
+        a small run.
+    executor : concurrent.futures.Executor or dask.distributed.Client, optional
+        Run the subdivision there instead.
 
     Returns
     -------
@@ -117,12 +128,13 @@ def mesh(shape: Any, tolerance: Optional[float] = None,
                          f"{grid.depth + refine} octree levels, over the {MAX_BITS} there are; "
                          "raise tolerance or lower refine")
     return mesh_grid(shape, grid, refine=refine, progress=progress,
-                     budget=memory_budget(max_memory), prune=validate.boolean(prune, "prune"))
+                     budget=memory_budget(max_memory), prune=validate.boolean(prune, "prune"),
+                     workers=validate.workers(workers), executor=validate.executor(executor))
 
 
 def mesh_grid(shape: Any, grid: Grid, *, refine: int = REFINE,
               progress: Optional[Callable[[float], Any]] = None, budget: int,
-              prune: bool = True) -> Any:
+              prune: bool = True, workers: Optional[int] = None, executor: Any = None) -> Any:
     """:func:`mesh` on a given grid (its voxels are the largest cells), under a
     byte ``budget``; :meth:`implicitvox.Voxels.to_mesh` uses it."""
     import pyvista as pv
@@ -141,8 +153,18 @@ def mesh_grid(shape: Any, grid: Grid, *, refine: int = REFINE,
     guard = MemoryGuard(budget, what, BYTES_PER_CELL, estimated_voxels=estimated)
     t0 = time.perf_counter()
     share = progress if progress is not None else (lambda s: None)
+    workers = plan_workers(workers, executor, estimated / _LEAVES_PER_VOXEL)
+    split = None
+    if workers > 1 or executor is not None:
+        options = {"interior": False, "normals": False, "mean_value": False, "subvoxel": 0,
+                   "recheck": RECHECK, "prune": prune}
+        split = subdivide_in_parallel(shape, func, grid, options, workers=workers,
+                                      executor=executor, progress=lambda s: share(0.3 * s),
+                                      budget=budget, per_voxel=BYTES_PER_CELL, guard=guard,
+                                      what=what, tapes=True)
     agrid = adaptive_grid(func, grid, refine, exact=exact, exact_voxels=exact_voxels,
-                          progress=lambda s: share(0.6 * s), guard=guard, prune=prune)
+                          progress=lambda s: share(0.6 * s), guard=guard, prune=prune,
+                          voxels=None if split is None else split[0])
     h = max(grid.voxel_size)
     contour = dual_contour(func, agrid, bound=h * math.sqrt(3),
                            progress=lambda s: share(0.6 + 0.35 * s))
@@ -158,6 +180,7 @@ def mesh_grid(shape: Any, grid: Grid, *, refine: int = REFINE,
     out.field_data["non_manifold_edges"] = [non_manifold]
     out.field_data["leaves"] = [agrid.count]
     out.field_data["seconds"] = [time.perf_counter() - t0]
+    out.field_data["workers"] = [workers if split is not None else 1]
     out.field_data["implicitvox"] = [__version__]
     if contour.uncovered:
         warnings.warn(f"{contour.uncovered:,} cells of size {h / 2 ** refine:.3g} may hold "

@@ -64,14 +64,17 @@ class SubtreeResult:
     interior: dict = field(default_factory=dict)
     evaluated: int = 0
     tapes_built: int = 0
+    #: runs ``(count, tape)`` of the pruned tapes over ``codes`` (when asked for)
+    tapes: list = field(default_factory=list)
 
 
 class SubtreeJob(Job):
     """The subdivision of subtrees at ``level``, shared by every piece of one run."""
 
     def __init__(self, shape: Any, func: Function, grid: Grid, options: dict, level: int,
-                 budget: int, per_voxel: int, what: str):
+                 budget: int, per_voxel: int, what: str, tapes: bool = False):
         super().__init__()
+        self.tapes = tapes
         self.shape, self.func, self.grid, self.options = shape, func, grid, dict(options)
         self.level, self.budget, self.per_voxel, self.what = level, int(budget), per_voxel, what
 
@@ -90,7 +93,8 @@ class SubtreeJob(Job):
         payload = surface_payload(self.func, self.grid, result, self.options["normals"])
         return SubtreeResult(result.codes, payload,
                              {lvl: morton.encode(c) for lvl, c in result.interior.items()},
-                             result.evaluated, result.tapes_built)
+                             result.evaluated, result.tapes_built,
+                             result.tapes if self.tapes else [])
 
 
 def parallel_bytes(voxels: int, per_voxel: int, working: int, workers: int) -> int:
@@ -107,15 +111,19 @@ def subdivide_in_parallel(shape: Any, func: Function, grid: Grid, options: dict,
                           progress: Optional[Callable[[float], Any]] = None,
                           start: Optional[tuple[int, np.ndarray]] = None,
                           budget: int, per_voxel: int, guard: Optional[MemoryGuard] = None,
-                          what: str = "voxelizing") -> Optional[tuple[Subdivision, dict]]:
+                          what: str = "voxelizing", tapes: bool = False
+                          ) -> Optional[tuple[Subdivision, dict]]:
     """The serial run's :class:`Subdivision` (codes, interior, boxes evaluated) and
     payload, computed by ``workers`` processes or ``executor``.
 
     Returns None when the octree is too shallow to split (fewer than
-    :data:`MIN_LEVELS_BELOW` levels below level 1): the caller runs serially. ``start``: continue from these octants (``Voxels.refine``),
-    which are then the pieces. ``guard`` watches the master's holdings as the
-    results arrive; each worker has its own, of ``budget / (workers + 1)`` at
-    ``per_voxel`` bytes per voxel kept.
+    :data:`MIN_LEVELS_BELOW` levels below level 1): the caller runs serially.
+    ``start``: continue from these octants (``Voxels.refine``), which are then
+    the pieces. ``guard`` watches the master's holdings as the results arrive;
+    each worker has its own, of ``budget / (workers + 1)`` at ``per_voxel``
+    bytes per voxel kept. ``tapes``: return the workers' pruned tapes too
+    (:attr:`Subdivision.tapes`, in the order of the codes as they arrived; the
+    mesher evaluates with them).
     """
     s = options["subvoxel"]
     depth = grid.depth + s                     # levels of the grid subdivided
@@ -140,7 +148,9 @@ def subdivide_in_parallel(shape: Any, func: Function, grid: Grid, options: dict,
                     or level == deepest:
                 break
     ranges = split_evenly(len(pending), pieces_wanted)
-    job = SubtreeJob(shape, func, grid, options, level, budget // (workers + 1), per_voxel, what)
+    job = SubtreeJob(shape, func, grid, options, level, budget // (workers + 1), per_voxel, what,
+                     tapes)
+    runs: list = []
     codes: list[np.ndarray] = []
     payload: dict[str, list] = {}
     interior: dict[int, list] = {}
@@ -154,6 +164,7 @@ def subdivide_in_parallel(shape: Any, func: Function, grid: Grid, options: dict,
                         executor=executor, weights=[b - a for a, b in ranges],
                         progress=progress, what=what):
         codes.append(part.codes)
+        runs.extend(part.tapes)
         for key, values in part.payload.items():
             payload.setdefault(key, []).append(values)
         for lvl, c in part.interior.items():
@@ -167,5 +178,5 @@ def subdivide_in_parallel(shape: Any, func: Function, grid: Grid, options: dict,
         codes=np.concatenate(codes) if codes else np.zeros(0, dtype=np.uint64),
         interior={lvl: morton.decode(np.sort(np.concatenate(parts))).astype(np.int32)
                   for lvl, parts in sorted(interior.items())},
-        evaluated=evaluated, tapes_built=built)
+        evaluated=evaluated, tapes_built=built, tapes=runs)
     return result, {key: np.concatenate(values) for key, values in payload.items()}

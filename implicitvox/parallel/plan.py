@@ -17,7 +17,7 @@ import os
 from typing import Any, Optional
 
 __all__ = ["available_cores", "executor_workers", "plan_workers", "split_evenly",
-           "MIN_PARALLEL_WORK", "PIECES_PER_WORKER"]
+           "MIN_PARALLEL_WORK", "PIECES_PER_WORKER", "WORKERS_VARIABLE"]
 
 #: below this much work (estimated surface voxels, or triangle pairs) a run with the
 #: default ``workers=None`` stays serial: starting processes and shipping results
@@ -28,8 +28,24 @@ MIN_PARALLEL_WORK = 1 << 18
 PIECES_PER_WORKER = 8
 
 
+#: the environment variable that sets the default number of workers (as
+#: ``OMP_NUM_THREADS`` does for OpenMP): ``1`` keeps every run serial, for
+#: instance under pytest-xdist, which runs one test per core already
+WORKERS_VARIABLE = "IMPLICITVOX_WORKERS"
+
+
 def available_cores() -> int:
-    """The cores this process may run on (its CPU affinity), at least 1."""
+    """The workers a run may use by default: ``$IMPLICITVOX_WORKERS`` if set, else
+    the cores this process may run on (its CPU affinity); 1 inside a daemonic
+    process (a worker of someone's pool), which may not start processes."""
+    import multiprocessing
+    if multiprocessing.current_process().daemon:
+        return 1
+    setting = os.environ.get(WORKERS_VARIABLE, "").strip()
+    if setting:
+        if not setting.isdigit() or int(setting) < 1:
+            raise ValueError(f"{WORKERS_VARIABLE} must be a positive int, got {setting!r}")
+        return int(setting)
     try:
         return max(1, len(os.sched_getaffinity(0)))
     except (AttributeError, OSError):
@@ -50,7 +66,8 @@ def plan_workers(workers: Optional[int], executor: Any, work: float,
                  cores: Optional[int] = None) -> int:
     """Workers for a run of ``work`` units: ``workers`` if given; with an
     executor, its workers; else every core, or 1 when ``work`` is below
-    :data:`MIN_PARALLEL_WORK`. 1 means serial, in this process."""
+    :data:`MIN_PARALLEL_WORK` (:func:`available_cores`: ``$IMPLICITVOX_WORKERS``
+    sets the default). 1 means serial, in this process."""
     if workers is not None:
         return workers
     if executor is not None:

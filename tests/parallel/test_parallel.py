@@ -189,6 +189,20 @@ def test_ctrl_c_stops_the_master_and_every_worker(tmp_path):
         pytest.fail("worker processes outlived the interrupted run")
 
 
+def test_the_default_uses_every_core_when_it_pays(monkeypatch):
+    from implicitvox.parallel import plan
+    monkeypatch.setattr(plan, "MIN_PARALLEL_WORK", 1)
+    monkeypatch.setenv("IMPLICITVOX_WORKERS", "2")
+    assert iv.voxelize(examples.example("gear"), 48).metadata["workers"] == 2
+    monkeypatch.setattr(plan, "MIN_PARALLEL_WORK", 1 << 40)
+    assert iv.voxelize(examples.example("gear"), 48).metadata["workers"] == 1
+    monkeypatch.setenv("IMPLICITVOX_WORKERS", "none")
+    with pytest.raises(ValueError, match="IMPLICITVOX_WORKERS must be a positive int"):
+        iv.voxelize(examples.example("gear"), 48)
+    monkeypatch.delenv("IMPLICITVOX_WORKERS")
+    assert plan.available_cores() == len(os.sched_getaffinity(0))
+
+
 def test_plan_and_split():
     assert plan_workers(None, None, work=1, cores=4) == 1
     assert plan_workers(None, None, work=1e9, cores=4) == 4
@@ -244,3 +258,25 @@ def test_forkserver_when_other_threads_run():
     finally:
         stop.set()
         thread.join()
+
+
+def test_mesh_and_distance_field_in_parallel():
+    """mesh: the subdivision on workers, the same triangles; distance_field: the
+    band's chunks on workers, the same values and errors (certified and mesh kernels)."""
+    from implicitvox import hypot, x, y, z
+    gear = examples.example("gear")
+    one, two = (iv.mesh(gear, resolution=48, workers=n) for n in (1, 2))
+    assert int(two.field_data["workers"][0]) == 2
+    assert np.array_equal(one.points, two.points) and np.array_equal(one.faces, two.faces)
+    torus = (hypot(x, y) - 0.6) ** 2 + z ** 2 - 0.1 ** 2
+    cube = ((-1,) * 3, (1,) * 3)
+    serial = iv.distance_field(torus, 32, band=1, bounds=cube, workers=1,
+                               check_suitability=False)
+    farmed = iv.distance_field(torus, 32, band=1, bounds=cube, workers=2,
+                               check_suitability=False)
+    assert farmed.metadata["workers"] == 2 and serial.kind == "certified"
+    assert np.array_equal(serial.values, farmed.values, equal_nan=True)   # NaN: off the grid
+    assert np.array_equal(serial.errors, farmed.errors, equal_nan=True)
+    bunny = [iv.distance_field(BUNNY, 56, band=1, norm="linf", workers=n) for n in (1, 2)]
+    assert bunny[1].metadata["workers"] == 2
+    assert np.array_equal(bunny[0].values, bunny[1].values, equal_nan=True)

@@ -25,9 +25,12 @@ def test_a_run_that_beats_its_estimate_stops_at_the_budget():
         warnings.simplefilter("ignore", UserWarning)
         with pytest.raises(MemoryError, match="stopped after .* surface voxels .the estimate "
                                               "said ~1,048,576.*over the budget"):
-            ivx.voxelize(WIGGLY, 128, bounds=CUBE, max_memory=int(estimated * 1.1))
+            ivx.voxelize(WIGGLY, 128, bounds=CUBE, max_memory=int(estimated * 1.1), workers=1)
+        # workers need room of their own: counted in the estimate, refused before starting
+        with pytest.raises(MemoryError, match=r"2 workers\) needs an estimated"):
+            ivx.voxelize(WIGGLY, 128, bounds=CUBE, max_memory=int(estimated * 1.1), workers=2)
         # with room for what it really keeps, the same run completes
-        vox = ivx.voxelize(WIGGLY, 128, bounds=CUBE, max_memory=int(estimated * 2))
+        vox = ivx.voxelize(WIGGLY, 128, bounds=CUBE, max_memory=int(estimated * 2), workers=1)
     assert vox.count > 1_048_576 * 1.5
 
 
