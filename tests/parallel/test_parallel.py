@@ -196,6 +196,7 @@ def test_the_default_uses_every_core_when_it_pays(monkeypatch):
     assert iv.voxelize(examples.example("gear"), 48).metadata["workers"] == 2
     monkeypatch.setattr(plan, "MIN_PARALLEL_WORK", 1 << 40)
     assert iv.voxelize(examples.example("gear"), 48).metadata["workers"] == 1
+    monkeypatch.setattr(plan, "MIN_PARALLEL_WORK", 1)
     monkeypatch.setenv("IMPLICITVOX_WORKERS", "none")
     with pytest.raises(ValueError, match="IMPLICITVOX_WORKERS must be a positive int"):
         iv.voxelize(examples.example("gear"), 48)
