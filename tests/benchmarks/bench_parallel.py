@@ -1,0 +1,186 @@
+"""Benchmark: parallel subdivision (issue 21, Stolte §5.2): 1 worker against 2, in one run.
+
+Run: ``python tests/benchmarks/bench_parallel.py [--cases ...] [--repeat 2] [--quick]
+[--no-dask] [--threads] [--huge]``
+
+For each case, in one process, alternately (best of ``--repeat`` each):
+
+* ``serial``: ``workers=1``, in this process;
+* ``2 processes``: ``workers=2``, a pool of this machine;
+* ``threads``: a ``ThreadPoolExecutor(2)`` as the executor (``--threads``): the
+  kernels are numpy calls that hold the GIL between them, so this measures
+  what processes buy over threads;
+* ``LocalCluster``: a Dask ``LocalCluster(n_workers=2, processes=True)``
+  client as the executor (started once, before the timings).
+
+It prints seconds, the yield ``t1 / (n tn)`` (Stolte's Table 1; 1 is perfect)
+and checks that every run gives the serial run's voxels (a digest of the
+sorted codes and the interior). Cases: sin(9θ)sin(18φ) − r and the gear at
+1024³, the Stanford bunny (mesh) at 512³, the level-3 Menger sponge at 512³.
+
+``--huge``: sin(3θ)sin(4φ) − r at 2048³ through the 2-worker LocalCluster and
+serially, the voxel counts compared, time and peak memory of each (about ten
+minutes; the table ``parallel-huge``).
+"""
+from __future__ import annotations
+
+import argparse
+import hashlib
+import os
+import sys
+import time
+from concurrent.futures import ThreadPoolExecutor
+
+import numpy as np
+
+import implicitvox as iv
+from implicitvox.expr import examples
+from implicitvox.triangles.inputs import as_triangles
+
+try:
+    from tests.benchmarks import tables
+except ImportError:        # run as a script from elsewhere
+    sys.path.insert(0, str(__import__("pathlib").Path(__file__).resolve().parents[2]))
+    from tests.benchmarks import tables
+
+BUNNY = os.path.join(os.path.dirname(__file__), "..", "..", "..", "shared", "data", "meshes",
+                     "stanford-bunny.obj")
+#: name -> (model, resolution, quick resolution)
+CASES = {
+    "sinsin918": ("sinsin918", 1024, 128),
+    "gear": ("gear", 1024, 128),
+    "bunny": ("bunny", 512, 128),
+    "menger": ("menger", 512, 128),
+}
+
+
+def _digest(vox) -> str:
+    h = hashlib.sha256(np.ascontiguousarray(vox.coords()).tobytes())
+    for level in sorted(vox.interior):
+        h.update(np.ascontiguousarray(vox.interior[level]).tobytes())
+    return h.hexdigest()[:12]
+
+
+def _model(name: str):
+    if name == "bunny":
+        return as_triangles(BUNNY)       # read once: the runs time the voxelization
+    return examples.example(name)
+
+
+def _voxelize(model, res: int, **parallel):
+    if isinstance(model, tuple):
+        return iv.voxelize_mesh(model, res, **parallel)
+    return iv.voxelize(model, res, **parallel)
+
+
+def _time(model, res: int, **parallel) -> tuple[float, object]:
+    t = time.perf_counter()
+    vox = _voxelize(model, res, **parallel)
+    return time.perf_counter() - t, vox
+
+
+def _cluster():
+    from distributed import Client, LocalCluster
+    cluster = LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
+                           dashboard_address=None)
+    return cluster, Client(cluster)
+
+
+def _fmt(seconds: float) -> str:
+    return f"{seconds:.2f}"
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--cases", nargs="+", default=list(CASES), choices=list(CASES))
+    parser.add_argument("--repeat", type=int, default=2)
+    parser.add_argument("--quick", action="store_true", help="small resolutions (a smoke run)")
+    parser.add_argument("--no-dask", action="store_true", help="skip the LocalCluster runs")
+    parser.add_argument("--threads", action="store_true", help="also a 2-thread executor")
+    parser.add_argument("--huge", action="store_true",
+                        help="only sin(3θ)sin(4φ) − r at 2048³ through the LocalCluster")
+    args = parser.parse_args()
+    load = tables.load_average()
+    print(f"load average before: {load}; {tables.machine()}")
+    if args.huge:
+        return huge(load, args.quick)
+    cluster = client = None
+    if not args.no_dask:
+        cluster, client = _cluster()
+    modes = {"serial": {"workers": 1}, "2 processes": {"workers": 2}}
+    if args.threads:
+        modes["2 threads"] = "threads"
+    if client is not None:
+        modes["LocalCluster (2)"] = {"executor": client}
+    rows = []
+    try:
+        for name in args.cases:
+            model_name, res, quick = CASES[name]
+            res = quick if args.quick else res
+            model = _model(model_name)
+            best = {mode: np.inf for mode in modes}
+            digests = {}
+            for _ in range(args.repeat):
+                for mode, parallel in modes.items():          # alternated, A B C A B C
+                    if parallel == "threads":
+                        with ThreadPoolExecutor(2) as pool:
+                            seconds, vox = _time(model, res, executor=pool, workers=2)
+                    else:
+                        seconds, vox = _time(model, res, **parallel)
+                    best[mode] = min(best[mode], seconds)
+                    digests.setdefault(mode, _digest(vox))
+                    count = vox.count
+                    del vox
+            t1 = best["serial"]
+            for mode in modes:
+                n = 1 if mode == "serial" else 2
+                same = "yes" if digests[mode] == digests["serial"] else "NO"
+                row = [name, f"{res}³", f"{count:,}", mode, _fmt(best[mode]),
+                       f"{t1 / (n * best[mode]):.2f}", same]
+                print(" | ".join(row), flush=True)
+                rows.append(row)
+    finally:
+        if client is not None:
+            client.close()
+            cluster.close()
+    header = ["model", "N", "surface voxels", "run", "seconds (best of "
+              f"{args.repeat})", "yield t1/(n·tn)", "same voxels"]
+    if not args.quick:
+        tables.write("parallel", header, rows,
+                     "python tests/benchmarks/bench_parallel.py " + " ".join(sys.argv[1:]),
+                     load)
+
+
+def huge(load: str, quick: bool) -> None:
+    """sin(3θ)sin(4φ) − r at 2048³: a 2-worker LocalCluster, then serially."""
+    shape = examples.example("sinsin34")
+    res = 256 if quick else 2048
+    cluster, client = _cluster()
+    try:
+        t = time.perf_counter()
+        farmed = iv.voxelize(shape, res, executor=client)
+        t_farmed = time.perf_counter() - t
+        count_farmed, bytes_farmed = farmed.count, farmed.octree.nbytes
+        digest_farmed = _digest(farmed)
+        del farmed
+    finally:
+        client.close()
+        cluster.close()
+    print(f"LocalCluster: {count_farmed:,} voxels in {t_farmed:.1f} s", flush=True)
+    t = time.perf_counter()
+    serial = iv.voxelize(shape, res, workers=1)
+    t_serial = time.perf_counter() - t
+    same = "yes" if _digest(serial) == digest_farmed else "NO"
+    print(f"serial: {serial.count:,} voxels in {t_serial:.1f} s; same voxels: {same}")
+    rows = [["sinsin34", f"{res}³", "LocalCluster (2)", f"{count_farmed:,}",
+             f"{bytes_farmed / 2**20:,.0f}", f"{t_farmed:.1f}", same],
+            ["sinsin34", f"{res}³", "serial", f"{serial.count:,}",
+             f"{serial.octree.nbytes / 2**20:,.0f}", f"{t_serial:.1f}", "-"]]
+    if not quick:
+        tables.write("parallel-huge", ["model", "N", "run", "surface voxels", "octree MiB",
+                                       "seconds", "same voxels"], rows,
+                     "python tests/benchmarks/bench_parallel.py --huge", load)
+
+
+if __name__ == "__main__":
+    main()
