@@ -164,7 +164,7 @@ def mesh_grid(shape: Any, grid: Grid, *, refine: int = REFINE,
                                       what=what, tapes=True)
     agrid = adaptive_grid(func, grid, refine, exact=exact, exact_voxels=exact_voxels,
                           progress=lambda s: share(0.6 * s), guard=guard, prune=prune,
-                          voxels=None if split is None else split[0])
+                          voxels=None if split is None else split.result)
     h = max(grid.voxel_size)
     contour = dual_contour(func, agrid, bound=h * math.sqrt(3),
                            progress=lambda s: share(0.6 + 0.35 * s))

@@ -41,7 +41,7 @@ import numpy as np
 
 from . import morton
 
-__all__ = ["Octree", "PointerOctree"]
+__all__ = ["Octree", "PointerOctree", "subtree_masks"]
 
 _POPCOUNT = np.array([bin(v).count("1") for v in range(256)], dtype=np.uint8)
 _BELOW = np.array([[bin(v & ((1 << c) - 1)).count("1") for c in range(8)] for v in range(256)],
@@ -55,6 +55,38 @@ def _low_byte(codes: np.ndarray) -> np.ndarray:
     if sys.byteorder == "little" and codes.flags.c_contiguous:
         return codes.view(np.uint8)[::8]
     return (codes & _U(255)).astype(np.uint8)
+
+
+def subtree_masks(codes: np.ndarray, depth: int, level: int
+                  ) -> tuple[list[np.ndarray], np.ndarray]:
+    """The child masks of levels ``level`` to ``depth - 1`` (a list, shallowest
+    first) of the voxels with sorted unique Morton codes ``codes`` at ``depth``,
+    and the codes of their ancestors at ``level`` (sorted unique): each level
+    from the one below with array operations."""
+    masks: list[np.ndarray] = []
+    level_codes = codes
+    for _ in range(depth - 1, level - 1, -1):
+        bits = _SLOT_BIT[_low_byte(level_codes) & 7]
+        parents = level_codes >> _U(3)
+        new_parent = np.empty(len(parents), dtype=bool)
+        new_parent[:1] = True
+        np.not_equal(parents[1:], parents[:-1], out=new_parent[1:])
+        starts = np.flatnonzero(new_parent)
+        del new_parent
+        masks.append(np.bitwise_or.reduceat(bits, starts) if len(bits) else
+                     np.zeros(0, dtype=np.uint8))
+        level_codes = parents[starts]
+    return masks[::-1], level_codes
+
+
+def _running_counts(masks: list[np.ndarray]) -> list[np.ndarray]:
+    """``first``: each node's index of its first child, the running count of the
+    children of the nodes before it, for every level but the last."""
+    first = []
+    for m in masks[:-1]:
+        counts = _POPCOUNT[m].astype(np.int64)
+        first.append((np.cumsum(counts) - counts).astype(np.uint32))
+    return first
 
 
 class Octree:
@@ -128,28 +160,45 @@ class Octree:
 
     @classmethod
     def _build(cls, codes: np.ndarray, depth: int,
-                           payload: dict[str, np.ndarray]) -> "Octree":
+               payload: dict[str, np.ndarray]) -> "Octree":
         if depth == 0:  # one voxel: a root mask with bit 0
             masks = [np.array([1], dtype=np.uint8)] if len(codes) else []
             return cls(0, masks, [], payload)
-        masks: list[np.ndarray] = [None] * depth  # type: ignore[list-item]
-        first: list[np.ndarray] = [None] * (depth - 1)  # type: ignore[list-item]
-        level_codes = codes
-        for level in range(depth - 1, -1, -1):
-            bits = _SLOT_BIT[_low_byte(level_codes) & 7]
-            parents = level_codes >> _U(3)
-            new_parent = np.empty(len(parents), dtype=bool)
-            new_parent[:1] = True
-            np.not_equal(parents[1:], parents[:-1], out=new_parent[1:])
-            starts = np.flatnonzero(new_parent)
-            del new_parent
-            masks[level] = np.bitwise_or.reduceat(bits, starts) if len(bits) else \
-                np.zeros(0, dtype=np.uint8)
-            if level < depth - 1:
-                counts = _POPCOUNT[masks[level]].astype(np.int64)
-                first[level] = (np.cumsum(counts) - counts).astype(np.uint32)
-            level_codes = parents[starts]
-        return cls(depth, masks, first, payload)
+        masks, _ = subtree_masks(codes, depth, 0)
+        return cls(depth, masks, _running_counts(masks), payload)
+
+    @classmethod
+    def from_subtrees(cls, depth: int, level: int, parts: list[tuple[np.ndarray, list]],
+                      payload: Optional[dict[str, np.ndarray]] = None) -> "Octree":
+        """The octree of voxels found subtree by subtree (a parallel run's workers).
+
+        ``parts`` are :func:`subtree_masks` ``(masks, ancestors)`` of disjoint
+        runs of subtrees rooted at ``level``, in Morton order (each run's
+        voxels all below the next run's): the levels from ``level`` down are
+        the runs' masks end to end, the levels above are built from their
+        ancestors. The same octree as :meth:`from_codes` on all the codes;
+        ``payload`` is already in Morton order.
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> codes = np.array([1, 5, 9, 200, 300], dtype=np.uint64)
+        >>> parts = [subtree_masks(codes[:3], 3, 1), subtree_masks(codes[3:], 3, 1)]
+        >>> whole = Octree.from_codes(codes.copy(), 3)
+        >>> joined = Octree.from_subtrees(3, 1, parts)
+        >>> all(np.array_equal(a, b) for a, b in zip(whole.masks + whole.first,
+        ...                                           joined.masks + joined.first))
+        True
+        """
+        parts = [p for p in parts if len(p[1])]
+        if not parts or depth == 0:
+            codes = np.concatenate([p[1] for p in parts]) if parts else np.zeros(0, dtype=_U)
+            return cls._build(codes, depth, dict(payload or {}))
+        ancestors = np.concatenate([a for _, a in parts])
+        top, _ = subtree_masks(ancestors, level, 0)
+        below = [np.concatenate([m[i] for m, _ in parts]) for i in range(depth - level)]
+        masks = top + below
+        return cls(depth, masks, _running_counts(masks), dict(payload or {}))
 
     def validate(self) -> None:
         """Check that the arrays describe an octree, before anything trusts them.

@@ -16,11 +16,16 @@ what they found. Here:
    and the options travel once per worker (a :class:`SubtreeJob`).
 3. Each worker continues the subdivision from its octants
    (:func:`~implicitvox.octree.surface.subdivide_voxels` with ``start``),
-   maps sub-voxels back, computes the normals of its voxels, and returns its
-   surface voxels (Morton codes), their normals and its FULL octants.
-4. The master merges each result as it arrives (the workers' working arrays
-   never reach it) and sorts: the octree, the interior octants (Morton order
-   per level) and the normals are **bit-identical** to the serial run's
+   maps sub-voxels back, computes the normals of its voxels, sorts them, and
+   returns its part of the octree (the child masks of its subtrees' levels,
+   :func:`~implicitvox.octree.store.subtree_masks`: about 1.3 bytes per voxel,
+   not an 8-byte code), their normals and its FULL octants.
+4. The master keeps each result as it arrives (the workers' working arrays
+   never reach it) and joins the parts in Morton order
+   (:meth:`~implicitvox.octree.store.Octree.from_subtrees`: the levels above
+   the split from the parts' roots, the levels below end to end; nothing is
+   sorted again): the octree, the interior octants (Morton order per level)
+   and the normals are **bit-identical** to the serial run's
    whatever the number of workers and the order pieces finish in, since a
    box's state depends on the box alone, a pruned tape's enclosures and
    gradients equal the full tape's bit for bit, and a voxel lies in exactly
@@ -39,11 +44,13 @@ from ..expr.shape import exact_classifier, voxel_classifier
 from . import morton
 from .grid import Grid
 from .guard import MemoryGuard
+from .store import Octree, subtree_masks
 from .subdivide import Subdivision
 from ..parallel import PIECES_PER_WORKER, Job, farm, split_evenly
 from .surface import subdivide_voxels, surface_payload
 
-__all__ = ["SubtreeJob", "SubtreeResult", "subdivide_in_parallel", "parallel_bytes",
+__all__ = ["SubtreeJob", "SubtreeResult", "ParallelSubdivision", "subdivide_in_parallel",
+           "parallel_bytes",
            "OCTANTS_PER_PIECE", "MIN_LEVELS_BELOW"]
 
 #: the split level is the first with at least this many AMBIGUOUS octants per piece
@@ -56,7 +63,8 @@ MIN_LEVELS_BELOW = 3
 class SubtreeResult:
     """What a worker found in its subtrees."""
 
-    #: Morton codes of the surface voxels (uint64, unsorted)
+    #: Morton codes of the surface voxels (uint64; with ``tapes``, in the order of the
+    #: tape runs; else sorted)
     codes: np.ndarray
     #: per-voxel arrays in the order of ``codes`` (the normals)
     payload: dict = field(default_factory=dict)
@@ -66,6 +74,11 @@ class SubtreeResult:
     tapes_built: int = 0
     #: runs ``(count, tape)`` of the pruned tapes over ``codes`` (when asked for)
     tapes: list = field(default_factory=list)
+    #: without ``tapes``: the subtrees' part of the octree (:func:`~implicitvox.octree.store.subtree_masks`
+    #: of the sorted codes at the job's level); ``codes`` are then not sent back
+    octree: Optional[tuple] = None
+    #: surface voxels found
+    count: int = 0
 
 
 class SubtreeJob(Job):
@@ -91,10 +104,36 @@ class SubtreeJob(Job):
         result = subdivide_voxels(self.func, self.grid, self.options, self.prepared_exact,
                                   start=(self.level, coords), guard=guard)
         payload = surface_payload(self.func, self.grid, result, self.options["normals"])
-        return SubtreeResult(result.codes, payload,
-                             {lvl: morton.encode(c) for lvl, c in result.interior.items()},
-                             result.evaluated, result.tapes_built,
-                             result.tapes if self.tapes else [])
+        interior = {lvl: morton.encode(c) for lvl, c in result.interior.items()}
+        count = len(result.codes)
+        if self.tapes:
+            return SubtreeResult(result.codes, payload, interior, result.evaluated,
+                                 result.tapes_built, result.tapes, count=count)
+        # sorted here, and sent as octree levels (about 1.3 bytes per voxel, not 8)
+        codes = result.codes
+        if payload:
+            order = np.argsort(codes, kind="stable")
+            codes = codes[order]
+            payload = {key: values[order] for key, values in payload.items()}
+        else:
+            codes.sort()
+        part = subtree_masks(codes, self.grid.depth, min(self.level, self.grid.depth))
+        return SubtreeResult(np.zeros(0, dtype=np.uint64), payload, interior, result.evaluated,
+                             result.tapes_built, octree=part, count=count)
+
+
+@dataclass
+class ParallelSubdivision:
+    """What :func:`subdivide_in_parallel` found."""
+
+    #: interior octants and boxes evaluated (with ``tapes``: also the codes and tapes)
+    result: Subdivision
+    #: per-voxel arrays, in Morton order (with ``tapes``: in the order of the codes)
+    payload: dict
+    #: the octree of the surface voxels (None with ``tapes``)
+    tree: Optional[Octree]
+    #: surface voxels
+    count: int
 
 
 def parallel_bytes(voxels: int, per_voxel: int, working: int, workers: int) -> int:
@@ -112,18 +151,18 @@ def subdivide_in_parallel(shape: Any, func: Function, grid: Grid, options: dict,
                           start: Optional[tuple[int, np.ndarray]] = None,
                           budget: int, per_voxel: int, guard: Optional[MemoryGuard] = None,
                           what: str = "voxelizing", tapes: bool = False
-                          ) -> Optional[tuple[Subdivision, dict]]:
-    """The serial run's :class:`Subdivision` (codes, interior, boxes evaluated) and
-    payload, computed by ``workers`` processes or ``executor``.
+                          ) -> Optional["ParallelSubdivision"]:
+    """The serial run's octree, interior and boxes evaluated, computed by
+    ``workers`` processes or ``executor``.
 
     Returns None when the octree is too shallow to split (fewer than
     :data:`MIN_LEVELS_BELOW` levels below level 1): the caller runs serially.
     ``start``: continue from these octants (``Voxels.refine``), which are then
     the pieces. ``guard`` watches the master's holdings as the results arrive;
     each worker has its own, of ``budget / (workers + 1)`` at ``per_voxel``
-    bytes per voxel kept. ``tapes``: return the workers' pruned tapes too
-    (:attr:`Subdivision.tapes`, in the order of the codes as they arrived; the
-    mesher evaluates with them).
+    bytes per voxel kept. ``tapes``: return the voxels' codes and the workers'
+    pruned tapes (:attr:`Subdivision.tapes`, in the order of the codes as they
+    arrived; the mesher evaluates with them) instead of the octree.
     """
     s = options["subvoxel"]
     depth = grid.depth + s                     # levels of the grid subdivided
@@ -160,23 +199,32 @@ def subdivide_in_parallel(shape: Any, func: Function, grid: Grid, options: dict,
         for lvl, c in head.interior.items():
             interior.setdefault(lvl, []).append(morton.encode(c))
     kept = 0
-    for _, part in farm(job, [pending[a:b] for a, b in ranges], workers=workers,
-                        executor=executor, weights=[b - a for a, b in ranges],
-                        progress=progress, what=what):
+    parts: dict[int, SubtreeResult] = {}          # by piece: merged in Morton order
+    for index, part in farm(job, [pending[a:b] for a, b in ranges], workers=workers,
+                            executor=executor, weights=[b - a for a, b in ranges],
+                            progress=progress, what=what):
+        parts[index] = part
         codes.append(part.codes)
         runs.extend(part.tapes)
-        for key, values in part.payload.items():
-            payload.setdefault(key, []).append(values)
         for lvl, c in part.interior.items():
             interior.setdefault(lvl, []).append(c)
         evaluated += part.evaluated
         built += part.tapes_built
-        kept += len(part.codes)
+        kept += part.count
         if guard is not None:
-            guard.check(kept, sum(len(c) for parts in interior.values() for c in parts))
+            guard.check(kept, sum(len(c) for group in interior.values() for c in group))
+    ordered = [parts[i] for i in sorted(parts)] if not tapes else list(parts.values())
+    for part in ordered:
+        for key, values in part.payload.items():
+            payload.setdefault(key, []).append(values)
     result = Subdivision(
         codes=np.concatenate(codes) if codes else np.zeros(0, dtype=np.uint64),
-        interior={lvl: morton.decode(np.sort(np.concatenate(parts))).astype(np.int32)
-                  for lvl, parts in sorted(interior.items())},
+        interior={lvl: morton.decode(np.sort(np.concatenate(group))).astype(np.int32)
+                  for lvl, group in sorted(interior.items())},
         evaluated=evaluated, tapes_built=built, tapes=runs)
-    return result, {key: np.concatenate(values) for key, values in payload.items()}
+    merged = {key: np.concatenate(values) for key, values in payload.items()}
+    tree = None
+    if not tapes:
+        tree = Octree.from_subtrees(grid.depth, min(level, grid.depth),
+                                    [p.octree for p in ordered], merged)
+    return ParallelSubdivision(result, merged, tree, kept)

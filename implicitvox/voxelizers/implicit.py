@@ -253,11 +253,12 @@ def _run(source: ImplicitSource, grid: Grid, progress, start, interior_before,
                                   (exact_classifier(shape), voxel_classifier(shape)),
                                   progress, start, guard)
         payload = surface_payload(func, grid, result, options["normals"])
+        count = len(result.codes)
     else:
-        result, payload = split
+        result, count = split.result, split.count
     t1 = time.perf_counter()
-    _warn_if_useless(len(result.codes), grid)
-    tree = Octree.from_codes(result.codes, grid.depth, payload)
+    _warn_if_useless(count, grid)
+    tree = Octree.from_codes(result.codes, grid.depth, payload) if split is None else split.tree
     interior = dict(interior_before or {})
     for level, coords in result.interior.items():
         interior[level] = np.concatenate([interior[level], coords]) if level in interior else coords

@@ -108,7 +108,7 @@ def test_openscad_model_in_parallel():
 
 
 def test_dask_local_cluster_gives_the_serial_voxels():
-    distributed = pytest.importorskip("distributed", reason="dask.distributed is an extra")
+    import distributed          # a test dependency (pyproject: the test and dask extras)
     shape = examples.example("sinsin34")
     serial = iv.voxelize(shape, 48, interior=True, normals=True, workers=1)
     mesh_serial = iv.voxelize_mesh(BUNNY, 48, workers=1)
@@ -226,21 +226,26 @@ def test_bad_parallel_options_are_named(bad, error, match):
 
 
 def test_head_and_pieces_cover_the_serial_run():
-    """The split level's octants, subdivided apart, give the serial voxels."""
+    """The split level's octants, subdivided apart, give the serial octree, joined
+    from the workers' parts; and the serial voxels as codes with their tapes."""
     from implicitvox.eval.function import Function
     from implicitvox.octree.grid import Grid
     shape = examples.example("gear")
     grid = Grid.from_bounds(shape.bounds, 64)
     options = {"interior": True, "normals": False, "mean_value": False, "subvoxel": 0,
                "recheck": 0.25, "prune": True}
-    with ThreadPoolExecutor(2) as pool:
-        result, _ = subdivide_in_parallel(shape, Function(shape.expr), grid, options,
-                                          workers=3, executor=pool, budget=1 << 30,
-                                          per_voxel=48)
     serial = iv.voxelize(shape, bounds=grid.bounds, voxel_size=grid.voxel_size[0],
                          interior=True, workers=1)
-    assert np.array_equal(np.sort(result.codes), np.sort(
-        iv.octree.morton.encode(serial.coords())))
+    with ThreadPoolExecutor(2) as pool:
+        joined = subdivide_in_parallel(shape, Function(shape.expr), grid, options, workers=3,
+                                       executor=pool, budget=1 << 30, per_voxel=48)
+        codes = subdivide_in_parallel(shape, Function(shape.expr), grid, options, workers=3,
+                                      executor=pool, budget=1 << 30, per_voxel=48, tapes=True)
+    assert joined.count == serial.count == sum(n for n, _ in codes.result.tapes)
+    assert np.array_equal(joined.tree.coords(), serial.coords())
+    assert all(np.array_equal(a, b) for a, b in zip(joined.tree.first, serial.octree.first))
+    assert np.array_equal(np.sort(codes.result.codes),
+                          iv.octree.morton.encode(serial.coords()))
 
 
 def test_forkserver_when_other_threads_run():
