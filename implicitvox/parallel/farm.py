@@ -4,8 +4,10 @@ Three backends behind one generator, :func:`farm`:
 
 * ``workers=n`` (no executor): a ``ProcessPoolExecutor`` of ``n`` processes,
   forked (or, when this process runs other threads, started by a
-  ``forkserver`` with ``implicitvox`` preloaded: see :func:`pool_context`), the
-  job installed by the pool's initializer: it travels once per worker.
+  ``forkserver`` with ``implicitvox`` preloaded: see :func:`pool_context`),
+  kept for the next run (starting workers costs more than a small run); the
+  job is pickled once into a file (in ``/dev/shm`` where there is one) that
+  each worker reads on its first piece: it travels once per worker.
 * ``executor=`` a ``dask.distributed.Client``: the job is ``scatter``-ed to
   every worker (``broadcast=True``) and each piece is a task reading it
   there; Dask retries a piece whose worker died and then reports it
@@ -34,14 +36,15 @@ Examples
 from __future__ import annotations
 
 import multiprocessing
+import os
 import threading
 from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 from concurrent.futures.process import BrokenProcessPool
 from typing import Any, Callable, Iterator, Optional, Sequence
 
-from .jobs import Job, install, run_piece
+from .jobs import Job, run_piece, run_stored_piece, store_job
 
-__all__ = ["farm", "WorkerError", "pool_context"]
+__all__ = ["farm", "WorkerError", "pool_context", "shutdown_pools"]
 
 
 class WorkerError(RuntimeError):
@@ -88,6 +91,7 @@ def farm(job: Job, pieces: Sequence[Any], *, workers: int = 2, executor: Any = N
     else:
         backend = _Futures(job, executor)
     done = 0.0
+    ok = False
     try:
         pending = {backend.submit(piece): i for i, piece in enumerate(pieces)}
         finished = 0
@@ -98,8 +102,11 @@ def farm(job: Job, pieces: Sequence[Any], *, workers: int = 2, executor: Any = N
             if progress is not None:
                 progress(min(done / total, 1.0))
             yield index, result
+        backend.finish()
+        ok = True
     finally:
-        backend.close()
+        if not ok:
+            backend.close()
 
 
 def _is_dask(executor: Any) -> bool:
@@ -114,15 +121,16 @@ def _died(done: int, count: int, what: str, cause: BaseException) -> WorkerError
 
 
 class _OwnPool:
-    """A process pool of this machine, the job installed once per worker."""
+    """A process pool of this machine, kept between runs; the job is pickled once
+    into a file that each worker reads on its first piece (:func:`run_stored_piece`)."""
 
     def __init__(self, job: Job, workers: int):
         self.job = job
-        self.pool = ProcessPoolExecutor(max_workers=workers, mp_context=pool_context(),
-                                        initializer=install, initargs=(job,))
+        self.pool, self.key = _shared_pool(workers)
+        self.path = store_job(job)
 
     def submit(self, piece):
-        return self.pool.submit(run_piece, self.job.token, piece)
+        return self.pool.submit(run_stored_piece, self.job.token, self.path, piece)
 
     def completed(self, pending: dict) -> Iterator:
         return _as_completed(pending)
@@ -133,10 +141,17 @@ class _OwnPool:
         except BrokenProcessPool as err:
             raise _died(done, count, what, err) from None
 
+    def finish(self) -> None:
+        """The run is over and every piece came back: the pool stays for the next."""
+        _remove(self.path)
+
     def close(self) -> None:
+        """Stop the pool: an error, an interrupt, a worker lost. A piece still
+        running is stopped, not waited for (Python 3.14 names this
+        ``terminate_workers``; before, the processes are reached through the pool)."""
+        _remove(self.path)
+        _POOLS.pop(self.key, None)
         self.pool.shutdown(wait=False, cancel_futures=True)
-        # a piece still running is stopped, not waited for (Python 3.14 names this
-        # terminate_workers; before, the processes are reached through the pool)
         terminate = getattr(self.pool, "terminate_workers", None)
         if terminate is not None:
             terminate()
@@ -146,7 +161,48 @@ class _OwnPool:
                 process.terminate()
 
 
+def _remove(path: str) -> None:
+    try:
+        os.unlink(path)
+    except OSError:
+        pass
+
+
+#: the pools kept between runs, by their number of workers
+_POOLS: dict = {}
+
+
+def _shared_pool(workers: int):
+    """The pool of ``workers`` processes kept for this process's runs (started on
+    first use, by :func:`pool_context`'s method), and its key."""
+    if workers not in _POOLS:
+        _POOLS[workers] = ProcessPoolExecutor(max_workers=workers, mp_context=pool_context())
+    return _POOLS[workers], workers
+
+
+def shutdown_pools() -> None:
+    """Stop the pools kept between runs (their workers hold the last jobs)."""
+    for pool in list(_POOLS.values()):
+        pool.shutdown(wait=True, cancel_futures=True)
+    _POOLS.clear()
+
+
 _FORKSERVER = None
+
+
+def _foreign_threads() -> bool:
+    """Whether threads other than the main one and those of this module's own
+    pools (their managers and queue feeders hold no lock a fork could copy
+    held) run in this process."""
+    own = ("concurrent.futures.process", "multiprocessing.queues")
+    for thread in threading.enumerate():
+        if thread is threading.main_thread():
+            continue
+        target = getattr(thread, "_target", None)
+        module = getattr(target, "__module__", None) or type(thread).__module__
+        if module not in own:
+            return True
+    return False
 
 
 def pool_context():
@@ -158,7 +214,7 @@ def pool_context():
     in each worker, so a script then needs the guard."""
     global _FORKSERVER
     methods = multiprocessing.get_all_start_methods()
-    if "fork" in methods and threading.active_count() == 1:
+    if "fork" in methods and not _foreign_threads():
         return multiprocessing.get_context("fork")
     if _FORKSERVER is None:
         if "forkserver" in methods:
@@ -190,6 +246,9 @@ class _Futures:
         except BrokenProcessPool as err:
             raise _died(done, count, what, err) from None
 
+    def finish(self) -> None:
+        pass
+
     def close(self) -> None:
         for future in self.futures:
             future.cancel()
@@ -219,6 +278,9 @@ class _Dask:
             return future.result()
         except KilledWorker as err:
             raise _died(done, count, what, err) from None
+
+    def finish(self) -> None:
+        self.client.cancel([self.shared])       # the job leaves the workers' memory
 
     def close(self) -> None:
         if self.futures:

@@ -17,16 +17,20 @@ from __future__ import annotations
 
 import ctypes
 import ctypes.util
+import os
+import pickle
 import sys
+import tempfile
 import uuid
 from collections import OrderedDict
 from typing import Any, Union
 
-__all__ = ["Job", "install", "run_piece", "tune_allocator", "INSTALLED_LIMIT",
+__all__ = ["Job", "install", "store_job", "run_stored_piece", "run_piece",
+           "tune_allocator", "INSTALLED_LIMIT",
            "MMAP_THRESHOLD", "TRIM_THRESHOLD"]
 
 #: jobs a worker process keeps installed (a long-lived Dask worker serves many runs)
-INSTALLED_LIMIT = 4
+INSTALLED_LIMIT = 2
 _INSTALLED: "OrderedDict[str, Job]" = OrderedDict()
 #: glibc's thresholds in a worker (:func:`tune_allocator`): arrays up to this size come
 #: from the heap, and the heap's top is returned to the system past the other
@@ -94,6 +98,26 @@ def install(job: Job) -> None:
     _INSTALLED.move_to_end(job.token)
     while len(_INSTALLED) > INSTALLED_LIMIT:
         _INSTALLED.popitem(last=False)
+
+
+def store_job(job: Job) -> str:
+    """Pickle ``job`` once into a file for :func:`run_stored_piece` (in ``/dev/shm``,
+    memory, where there is one); the caller removes it after the run."""
+    folder = "/dev/shm" if os.path.isdir("/dev/shm") and os.access("/dev/shm", os.W_OK) \
+        else None
+    handle, path = tempfile.mkstemp(prefix="implicitvox-job-", suffix=".pickle", dir=folder)
+    with os.fdopen(handle, "wb") as out:
+        pickle.dump(job, out, protocol=pickle.HIGHEST_PROTOCOL)
+    return path
+
+
+def run_stored_piece(token: str, path: str, piece: Any) -> Any:
+    """Run one piece of the job stored at ``path`` (read once per worker process)."""
+    if token not in _INSTALLED:
+        tune_allocator()
+        with open(path, "rb") as stored:
+            install(pickle.load(stored))
+    return run_piece(token, piece)
 
 
 def run_piece(job: Union[Job, str], piece: Any) -> Any:
