@@ -217,6 +217,10 @@ def _parser() -> argparse.ArgumentParser:
     return parser
 
 
+#: seconds ``--scheduler`` waits to reach the Dask scheduler
+SCHEDULER_TIMEOUT = 30
+
+
 def _parallel_options(command: argparse.ArgumentParser) -> None:
     command.add_argument("--workers", type=int, metavar="N",
                          help="processes to run on (default: every core, one for small runs)")
@@ -238,7 +242,7 @@ def _parallel(args: argparse.Namespace) -> Iterator[dict]:
         raise ModelError("--scheduler needs dask.distributed: pip install "
                          "'implicitvox[dask]'") from None
     try:
-        client = Client(args.scheduler, timeout=30)
+        client = Client(args.scheduler, timeout=SCHEDULER_TIMEOUT)
     except (OSError, TimeoutError) as err:
         raise ModelError(f"--scheduler {args.scheduler}: cannot reach it ({err})") from None
     with client:

@@ -19,8 +19,8 @@ sorted codes and the interior). Cases: sin(9θ)sin(18φ) − r and the gear at
 1024³, the Stanford bunny (mesh) at 512³, the level-3 Menger sponge at 512³.
 
 ``--huge``: sin(3θ)sin(4φ) − r at 2048³ through the 2-worker LocalCluster and
-serially, the voxel counts compared, time and peak memory of each (about ten
-minutes; the table ``parallel-huge``).
+serially, the voxels compared, the time and octree size of each (the table
+``parallel-huge``).
 """
 from __future__ import annotations
 

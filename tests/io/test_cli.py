@@ -62,6 +62,7 @@ def test_model_errors_name_the_model_line(tmp_path, capsys, source, match):
      "over the budget"),
     (["voxelize", "--example", "sphere", "--max-memory", "inf"], "--max-memory must be a positive"),
     (["voxelize", "--example", "sphere", "--voxel-size", "-1"], "voxel_size must be a positive"),
+    (["voxelize", "--example", "sphere", "--workers", "0"], "--workers must be an int from 1"),
 ])
 def test_bad_input_is_refused_clearly(argv, match, capsys):
     code, _, err = run(argv, capsys)
@@ -131,6 +132,26 @@ def test_an_unexpected_error_is_one_line_unless_debug(monkeypatch, capsys):
     assert err.count("\n") == 1 and "internal error: RuntimeError: a bug" in err
     assert cli.main(["--debug", "voxelize", "--example", "sphere"]) == 1
     assert "Traceback" in capsys.readouterr().err
+
+
+def test_an_unreachable_scheduler_is_named(monkeypatch, capsys):
+    from implicitvox.io import cli
+    monkeypatch.setattr(cli, "SCHEDULER_TIMEOUT", 1)
+    code, _, err = run(["mesh", "--example", "sphere", "--resolution", "8", "--scheduler",
+                        "tcp://127.0.0.1:9"], capsys)
+    assert code == 2 and "--scheduler tcp://127.0.0.1:9: cannot reach it" in err
+
+
+def test_workers_give_the_same_voxels(tmp_path, capsys):
+    files = []
+    for workers in ("1", "2"):
+        out_file = tmp_path / f"gear{workers}.npz"
+        code, _, err = run(["voxelize", "--example", "gear", "--resolution", "48", "--quiet",
+                            "--interior", "--workers", workers, "--out", str(out_file)], capsys)
+        assert code == 0, err
+        files.append(ivx.load(str(out_file)))
+    assert files[1].metadata["workers"] == 2
+    assert np.array_equal(files[0].coords(), files[1].coords())
 
 
 def test_no_prune_gives_the_same_voxels(tmp_path, capsys):

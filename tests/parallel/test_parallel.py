@@ -83,6 +83,16 @@ def test_any_schedule_gives_the_serial_voxels(seed):
     assert digest(vox) == digest(serial)
 
 
+def test_any_process_pool_as_executor():
+    """An Executor of the user's (the job goes with each piece, prepared once per worker)."""
+    from concurrent.futures import ProcessPoolExecutor
+    shape = examples.example("lobed-plate")
+    serial = iv.voxelize(shape, 40, interior=True, normals=True, workers=1)
+    with ProcessPoolExecutor(2) as pool:
+        vox = iv.voxelize(shape, 40, interior=True, normals=True, executor=pool, workers=2)
+    assert digest(vox) == digest(serial)
+
+
 def test_refine_in_parallel():
     """Voxels.refine reuses the run's workers, and matches the serial refine."""
     shape = examples.example("sinsin34")
