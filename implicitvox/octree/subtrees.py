@@ -53,8 +53,10 @@ __all__ = ["SubtreeJob", "SubtreeResult", "ParallelSubdivision", "subdivide_in_p
            "parallel_bytes",
            "OCTANTS_PER_PIECE", "MIN_LEVELS_BELOW"]
 
-#: the split level is the first with at least this many AMBIGUOUS octants per piece
-OCTANTS_PER_PIECE = 4
+#: the split level is the first with at least this many AMBIGUOUS octants per piece:
+#: a piece starts with full-sized batches (measured in bench_parallel.py: 4 octants
+#: per piece made the workers' first levels a string of small numpy calls)
+OCTANTS_PER_PIECE = 512
 #: ...and leaves at least this many levels to the workers (else the run is serial)
 MIN_LEVELS_BELOW = 3
 
