@@ -36,10 +36,15 @@ def test_gradient_matches_mpmath_derivative(expr, point):
                 if v is None:
                     raise ValueError
                 return v
+            at, h = mpmath.mpf(point[axis]), mpmath.mpf(10) ** -10
             try:
-                exact = mpmath.diff(along, mpmath.mpf(point[axis]), h=mpmath.mpf(10) ** -10)
+                exact = mpmath.diff(along, at, h=h)
+                left = mpmath.diff(along, at, h=h, direction=-1)
+                right = mpmath.diff(along, at, h=h, direction=1)
             except (ValueError, ZeroDivisionError):
                 return
+            # a kink (a sweep's fold, |t| at 0): no derivative there to match
+            assume(abs(left - right) <= 1e-6 * (1 + abs(exact)))
             assert abs(grad[axis] - float(exact)) <= 1e-7 * (1 + abs(float(exact)))
 
 
