@@ -26,7 +26,6 @@ from __future__ import annotations
 
 import argparse
 import hashlib
-import os
 import sys
 import time
 from concurrent.futures import ThreadPoolExecutor
@@ -43,8 +42,7 @@ except ImportError:        # run as a script from elsewhere
     sys.path.insert(0, str(__import__("pathlib").Path(__file__).resolve().parents[2]))
     from tests.benchmarks import tables
 
-BUNNY = os.path.join(os.path.dirname(__file__), "..", "..", "..", "shared", "data", "meshes",
-                     "stanford-bunny.obj")
+from tests.support.mesh_helpers import BUNNY     # noqa: E402 (the shared data's bunny)
 #: name -> (model, resolution, quick resolution)
 CASES = {
     "sinsin918": ("sinsin918", 1024, 128),

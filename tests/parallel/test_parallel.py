@@ -23,7 +23,17 @@ from implicitvox.octree.subtrees import subdivide_in_parallel
 
 HERE = os.path.dirname(__file__)
 FIXTURES = os.path.join(HERE, "..", "openscad")
-BUNNY = os.path.join(HERE, "..", "..", "..", "shared", "data", "meshes", "stanford-bunny.obj")
+
+
+def _torus_mesh():
+    """A closed mesh of about 20,000 triangles (a torus, from PyVista)."""
+    import pyvista as pv
+    knot = pv.ParametricTorus(ringradius=1.0, crosssectionradius=0.3, u_res=100, v_res=100,
+                              w_res=2).triangulate().clean()
+    return np.asarray(knot.points), knot.faces.reshape(-1, 4)[:, 1:]
+
+
+MESH = _torus_mesh()
 
 
 def digest(vox) -> str:
@@ -103,9 +113,9 @@ def test_refine_in_parallel():
 
 
 def test_meshes_and_patches_give_the_serial_voxels():
-    serial = iv.voxelize_mesh(BUNNY, 64, workers=1)
+    serial = iv.voxelize_mesh(MESH, 64, workers=1)
     for n in (2, 3):
-        assert np.array_equal(iv.voxelize_mesh(BUNNY, 64, workers=n).coords(), serial.coords())
+        assert np.array_equal(iv.voxelize_mesh(MESH, 64, workers=n).coords(), serial.coords())
     teapot = iv.voxelize_bezier(iv.utah_teapot(), 48, workers=1)
     assert np.array_equal(iv.voxelize_bezier(iv.utah_teapot(), 48, workers=2).coords(),
                           teapot.coords())
@@ -121,14 +131,14 @@ def test_dask_local_cluster_gives_the_serial_voxels():
     import distributed          # a test dependency (pyproject: the test and dask extras)
     shape = examples.example("sinsin34")
     serial = iv.voxelize(shape, 48, interior=True, normals=True, workers=1)
-    mesh_serial = iv.voxelize_mesh(BUNNY, 48, workers=1)
+    mesh_serial = iv.voxelize_mesh(MESH, 48, workers=1)
     with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
                                   dashboard_address=None) as cluster, \
             distributed.Client(cluster) as client:
         vox = iv.voxelize(shape, 48, interior=True, normals=True, executor=client)
         assert vox.metadata["workers"] == 2
         assert digest(vox) == digest(serial)
-        mesh_vox = iv.voxelize_mesh(BUNNY, 48, executor=client)
+        mesh_vox = iv.voxelize_mesh(MESH, 48, executor=client)
         assert np.array_equal(mesh_vox.coords(), mesh_serial.coords())
 
 
@@ -232,7 +242,7 @@ def test_bad_parallel_options_are_named(bad, error, match):
     with pytest.raises(error, match=match):
         iv.voxelize(examples.example("sphere"), 8, **bad)
     with pytest.raises(error, match=match):
-        iv.voxelize_mesh(BUNNY, 8, **bad)
+        iv.voxelize_mesh(MESH, 8, **bad)
 
 
 def test_head_and_pieces_cover_the_serial_run():
@@ -293,6 +303,6 @@ def test_mesh_and_distance_field_in_parallel():
     assert farmed.metadata["workers"] == 2 and serial.kind == "certified"
     assert np.array_equal(serial.values, farmed.values, equal_nan=True)   # NaN: off the grid
     assert np.array_equal(serial.errors, farmed.errors, equal_nan=True)
-    bunny = [iv.distance_field(BUNNY, 56, band=1, norm="linf", workers=n) for n in (1, 2)]
+    bunny = [iv.distance_field(MESH, 56, band=1, norm="linf", workers=n) for n in (1, 2)]
     assert bunny[1].metadata["workers"] == 2
     assert np.array_equal(bunny[0].values, bunny[1].values, equal_nan=True)
