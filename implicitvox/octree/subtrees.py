@@ -10,7 +10,8 @@ what they found. Here:
    (``until_level``, :class:`~implicitvox.octree.subdivide.Subdivision`
    ``.pending``), keeping the FULL octants it met on the way.
 2. Those octants, in Morton order, are cut into contiguous runs
-   (``PIECES_PER_WORKER`` per worker: neighbouring subtrees share pruned
+   (:func:`implicitvox.parallel.pieces_for`: from 2 to ``PIECES_PER_WORKER``
+   per worker, by the estimated voxels; neighbouring subtrees share pruned
    tapes, and the queue balances uneven runs) and farmed out
    (:func:`implicitvox.parallel.farm`). The shape, its compiled tape, the grid
    and the options travel once per worker (a :class:`SubtreeJob`).
@@ -46,7 +47,7 @@ from .grid import Grid
 from .guard import MemoryGuard
 from .store import Octree, subtree_masks
 from .subdivide import Subdivision
-from ..parallel import PIECES_PER_WORKER, Job, farm, split_evenly
+from ..parallel import PIECES_PER_WORKER, Job, farm, pieces_for, split_evenly
 from .surface import subdivide_voxels, surface_payload
 
 __all__ = ["SubtreeJob", "SubtreeResult", "ParallelSubdivision", "subdivide_in_parallel",
@@ -152,7 +153,8 @@ def subdivide_in_parallel(shape: Any, func: Function, grid: Grid, options: dict,
                           progress: Optional[Callable[[float], Any]] = None,
                           start: Optional[tuple[int, np.ndarray]] = None,
                           budget: int, per_voxel: int, guard: Optional[MemoryGuard] = None,
-                          what: str = "voxelizing", tapes: bool = False
+                          what: str = "voxelizing", tapes: bool = False,
+                          estimated: Optional[float] = None
                           ) -> Optional["ParallelSubdivision"]:
     """The serial run's octree, interior and boxes evaluated, computed by
     ``workers`` processes or ``executor``.
@@ -165,11 +167,14 @@ def subdivide_in_parallel(shape: Any, func: Function, grid: Grid, options: dict,
     bytes per voxel kept. ``tapes``: return the voxels' codes and the workers'
     pruned tapes (:attr:`Subdivision.tapes`, in the order of the codes as they
     arrived; the mesher evaluates with them) instead of the octree.
+    ``estimated``: the surface voxels expected, which set the number of pieces
+    (:func:`implicitvox.parallel.pieces_for`; default the most).
     """
     s = options["subvoxel"]
     depth = grid.depth + s                     # levels of the grid subdivided
     exact = (exact_classifier(shape), voxel_classifier(shape))
-    pieces_wanted = PIECES_PER_WORKER * workers
+    pieces_wanted = PIECES_PER_WORKER * workers if estimated is None else \
+        pieces_for(workers, estimated)
     heads: list[Subdivision] = []
     if start is not None:
         level, pending = start[0], morton.encode(start[1])

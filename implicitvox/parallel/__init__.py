@@ -19,9 +19,9 @@ itself (:mod:`implicitvox.octree.subtrees`, :mod:`implicitvox.triangles.pairs`,
 """
 from .farm import WorkerError, farm
 from .jobs import Job, run_piece
-from .plan import (MIN_PARALLEL_WORK, PIECES_PER_WORKER, WORKERS_VARIABLE, available_cores,
-                   executor_workers, plan_workers, split_evenly)
+from .plan import (MIN_PARALLEL_WORK, PIECES_PER_WORKER, WORK_PER_PIECE, WORKERS_VARIABLE,
+                   available_cores, executor_workers, pieces_for, plan_workers, split_evenly)
 
 __all__ = ["farm", "WorkerError", "Job", "run_piece", "available_cores", "executor_workers",
-           "plan_workers", "split_evenly", "MIN_PARALLEL_WORK", "PIECES_PER_WORKER",
-           "WORKERS_VARIABLE"]
+           "plan_workers", "pieces_for", "split_evenly", "MIN_PARALLEL_WORK", "PIECES_PER_WORKER",
+           "WORK_PER_PIECE", "WORKERS_VARIABLE"]

@@ -16,16 +16,20 @@ from __future__ import annotations
 import os
 from typing import Any, Optional
 
-__all__ = ["available_cores", "executor_workers", "plan_workers", "split_evenly",
-           "MIN_PARALLEL_WORK", "PIECES_PER_WORKER", "WORKERS_VARIABLE"]
+__all__ = ["available_cores", "executor_workers", "plan_workers", "pieces_for", "split_evenly",
+           "MIN_PARALLEL_WORK", "PIECES_PER_WORKER", "WORK_PER_PIECE", "WORKERS_VARIABLE"]
 
 #: below this much work (estimated surface voxels, or triangle pairs) a run with the
 #: default ``workers=None`` stays serial: starting processes and shipping results
 #: costs more than it saves (tests/benchmarks/bench_parallel.py measures it)
 MIN_PARALLEL_WORK = 1 << 18
-#: pieces per worker: enough that uneven subtrees balance on the queue, few enough
-#: that each piece keeps full-sized batches
+#: pieces per worker, at most: enough that uneven subtrees balance on the queue, few
+#: enough that each piece keeps full-sized batches
 PIECES_PER_WORKER = 8
+#: work per piece (surface voxels) below which a run is cut into fewer pieces, down to
+#: two per worker (each piece costs a few milliseconds of setting up, sorting and
+#: sending: measured in bench_parallel.py on the gear and the sponge)
+WORK_PER_PIECE = 1 << 19
 
 
 #: the environment variable that sets the default number of workers (as
@@ -75,6 +79,17 @@ def plan_workers(workers: Optional[int], executor: Any, work: float,
     if work < MIN_PARALLEL_WORK:
         return 1
     return available_cores() if cores is None else cores
+
+
+def pieces_for(workers: int, work: float) -> int:
+    """How many pieces a run of ``work`` units on ``workers`` is cut into: one per
+    :data:`WORK_PER_PIECE`, from 2 to :data:`PIECES_PER_WORKER` per worker.
+
+    >>> pieces_for(2, 2e6), pieces_for(2, 1e9), pieces_for(2, 10)
+    (4, 16, 4)
+    """
+    wanted = int(-(-work // WORK_PER_PIECE))
+    return max(2 * workers, min(PIECES_PER_WORKER * workers, wanted))
 
 
 def split_evenly(n: int, parts: int) -> list[tuple[int, int]]:

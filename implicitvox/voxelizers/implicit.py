@@ -247,7 +247,7 @@ def _run(source: ImplicitSource, grid: Grid, progress, start, interior_before,
         split = subdivide_in_parallel(shape, func, grid, options, workers=workers,
                                       executor=executor, progress=progress, start=start,
                                       budget=budget, per_voxel=per_voxel, guard=guard,
-                                      what=what)
+                                      what=what, estimated=estimated_voxels)
     if split is None:
         result = subdivide_voxels(func, grid, options,
                                   (exact_classifier(shape), voxel_classifier(shape)),
