@@ -77,45 +77,51 @@ class Contour:
 
 
 class _Locator:
-    """Leaves by level, for finding the leaf that holds a finest-level cell."""
+    """The leaf that holds a finest-level cell: the leaves are disjoint runs of the
+    finest level's Morton codes (a leaf at level ``l`` covers ``8**(depth - l)``
+    of them from its first), so one binary search over the runs' starts finds
+    it, whatever its level."""
 
     def __init__(self, agrid: AdaptiveGrid):
         self.depth = agrid.grid.depth
         self.shape = np.asarray(agrid.grid.shape)
-        self.coords = agrid.coords
-        self.by_level = []
-        for level in np.unique(agrid.levels):
-            idx = np.flatnonzero(agrid.levels == level)
-            codes = morton.encode(agrid.coords[idx])
-            order = np.argsort(codes)
-            self.by_level.append((int(level), codes[order], idx[order]))
+        shift = (3 * (self.depth - agrid.levels.astype(np.int64))).astype(np.uint64)
+        starts = morton.encode(agrid.coords) << shift
+        order = np.argsort(starts, kind="stable")
+        self.starts = starts[order]
+        self.ends = self.starts + (np.uint64(1) << shift[order])
+        self.index = order
+        self.levels = agrid.levels.astype(np.int64)[order]
+
+    def _codes(self, fine: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        inside = ((fine >= 0) & (fine < self.shape)).all(1)
+        return morton.encode(np.where(inside[:, None], fine, 0)), inside
 
     def split(self, fine: np.ndarray, level: np.ndarray) -> np.ndarray:
         """Whether the cell at ``level`` holding finest-level cell ``fine`` has
-        leaves below it (it was split)."""
-        out = np.zeros(len(fine), dtype=bool)
-        for deeper, codes, idx in self.by_level:
-            for at in np.unique(level[level < deeper]):
-                rows = np.flatnonzero(level == at)
-                ancestors = np.unique(morton.encode(
-                    self.coords[idx] >> (deeper - at)))
-                key = morton.encode(np.maximum(fine[rows], 0) >> (self.depth - at))
-                out[rows] |= np.isin(key, ancestors)
-        return out
+        leaves below it (it was split): a leaf deeper than ``level`` starts in
+        its run of finest codes."""
+        shift = (3 * (self.depth - np.asarray(level, dtype=np.int64))).astype(np.uint64)
+        codes = morton.encode(np.maximum(fine, 0))        # past the grid: no leaf there
+        first = (codes >> shift) << shift
+        lo = np.searchsorted(self.starts, first, side="left")
+        hi = np.searchsorted(self.starts, first + (np.uint64(1) << shift), side="left")
+        count = hi - lo
+        deeper = np.zeros(len(fine), dtype=bool)
+        one = count == 1
+        deeper[one] = self.levels[lo[one]] > np.asarray(level)[one]
+        return (count >= 2) | deeper
 
     def find(self, fine: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Leaf index and level (-1 where none) of finest-level cells ``fine`` (n, 3)."""
-        n = len(fine)
-        found = np.full(n, -1, dtype=np.int64)
-        level_of = np.full(n, -1, dtype=np.int64)
-        inside = ((fine >= 0) & (fine < self.shape)).all(1)
-        probe = np.where(inside[:, None], fine, 0)
-        for level, codes, idx in self.by_level:
-            key = morton.encode(probe >> (self.depth - level))
-            at = np.minimum(np.searchsorted(codes, key), len(codes) - 1)
-            hit = inside & (codes[at] == key) & (found < 0)
-            found[hit] = idx[at[hit]]
-            level_of[hit] = level
+        codes, inside = self._codes(fine)
+        at = np.searchsorted(self.starts, codes, side="right") - 1
+        hit = inside & (at >= 0)
+        hit[hit] = codes[hit] < self.ends[at[hit]]
+        found = np.full(len(fine), -1, dtype=np.int64)
+        level_of = np.full(len(fine), -1, dtype=np.int64)
+        found[hit] = self.index[at[hit]]
+        level_of[hit] = self.levels[at[hit]]
         return found, level_of
 
 
