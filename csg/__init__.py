@@ -20,7 +20,7 @@ from .primitives import (Box, ConvexPolyhedron, Cylinder, Ellipsoid, HalfSpace, 
 from .planar import Circle, Polygon, Rectangle, linear_extrude, rotate_extrude
 from .blends import Blobby, smooth_difference, smooth_intersection, smooth_union
 from .openscad import read_openscad
-from .openscad_parser import OpenSCADError
+from .openscad_parser import OpenSCADError, OpenSCADWarning
 from .scene import SceneError, load_json
 
 __all__ = [
@@ -30,5 +30,5 @@ __all__ = [
     "Polyhedron",
     "Circle", "Rectangle", "Polygon", "linear_extrude", "rotate_extrude",
     "smooth_union", "smooth_intersection", "smooth_difference", "Blobby",
-    "read_openscad", "OpenSCADError", "load_json", "SceneError",
+    "read_openscad", "OpenSCADError", "OpenSCADWarning", "load_json", "SceneError",
 ]

@@ -9,6 +9,14 @@ its subtree the whole design. Any other module
 (``hull``, ``minkowski``, ``offset``, ``text``, ``import``, ``resize``, ...) is
 refused with its name, line and column. Nothing is evaluated.
 
+Degenerate input is skipped, as OpenSCAD skips it, with an
+:class:`~csg.openscad_parser.OpenSCADWarning` naming line and column: a cube
+with a size of 0, a sphere or cylinder of radius or height 0 (or below), a
+singular ``multmatrix`` (a scale of 0), ``rotate_extrude(angle = 0)``, a 3D
+child of an extrusion, an invalid polyhedron. The rest of the file is read.
+A file whose design is 2D (OpenSCAD would export DXF or SVG) is refused at
+read time, saying so.
+
 ``facets="true"`` (default) voxelizes the true curved primitives;
 ``facets="openscad"`` reproduces OpenSCAD's own polygonization
 (:mod:`csg.facets`): spheres and cylinders become the convex polyhedra
@@ -30,12 +38,13 @@ from __future__ import annotations
 
 import math
 import os
+import warnings
 from typing import Any, Optional
 
 import numpy as np
 
 from . import facets as fx
-from .openscad_parser import Node, OpenSCADError, parse
+from .openscad_parser import Node, OpenSCADError, OpenSCADWarning, parse
 from .planar import Circle, LinearExtrude, Polygon, Rectangle, RotateExtrude
 from .primitives import Box, ConvexPolyhedron, Cylinder, Polyhedron, Sphere
 from .solid import Difference, Intersection, Solid, Transformed, Union
@@ -88,10 +97,18 @@ def read_openscad(path_or_text: Any, facets: str = "true") -> Solid:
         nodes = [root]
         root.modifiers = root.modifiers.replace("!", "")
     builder = _Builder(source, facets == "openscad")
-    solids = [s for s in (builder.build(n) for n in nodes) if s is not None]
-    if not solids:
+    built = [(n, s) for n, s in ((n, builder.build(n)) for n in nodes) if s is not None]
+    if not built:
         raise OpenSCADError("the file holds no geometry", 1, 1, source)
-    return solids[0] if len(solids) == 1 else Union(*solids)
+    solids = [s for _, s in built]
+    solid = solids[0] if len(solids) == 1 else Union(*solids)
+    if solid.dim == 2:
+        first = built[0][0]
+        raise OpenSCADError("the design is 2D (OpenSCAD exports it as DXF or SVG, not as a "
+                            "solid): implicitvox voxelizes 3D solids; extrude it "
+                            "(linear_extrude, rotate_extrude) first", first.line, first.column,
+                            source)
+    return solid
 
 
 def _root_node(nodes: list[Node]) -> Optional[Node]:
@@ -134,6 +151,12 @@ class _Builder:
 
     def error(self, node: Node, message: str) -> OpenSCADError:
         return OpenSCADError(message, node.line, node.column, self.source)
+
+    def skip(self, node: Node, message: str) -> None:
+        """Degenerate input OpenSCAD skips (with a warning): skipped here too, named."""
+        warnings.warn(f"{self.source}:{node.line}:{node.column}: {node.name}: {message}; "
+                      "skipped, as OpenSCAD does", OpenSCADWarning, stacklevel=4)
+        return None
 
     # -- arguments -------------------------------------------------------------------
     def arg(self, node: Node, name: str, default: Any = None, index: Optional[int] = None):
@@ -238,32 +261,49 @@ class _Builder:
         if mat.shape == (4, 4) and body.dim == 2:
             mat = mat.copy()
             mat[2], mat[:2, 2] = [0, 0, 1, 0], 0        # 2D: only the in-plane part acts
+        linear = mat[:3, :3] if mat.shape[0] == 4 else mat
+        if body.dim == 2:
+            linear = linear[:2, :2]
+        if abs(float(np.linalg.det(linear))) <= 1e-12 * max(1.0, float(np.abs(linear).max())) \
+                ** len(linear):
+            return self.skip(node, "the transform is singular (a scale of 0): its children "
+                                   "collapse to a plane, line or point")
         return Transformed(body, mat)
 
-    def _cube(self, node: Node) -> Solid:
-        return Box(self.vector(node, "size", 3, 1.0, 0), center=self.flag(node, "center"))
+    def _cube(self, node: Node) -> Optional[Solid]:
+        size = self.vector(node, "size", 3, 1.0, 0)
+        if not np.all(size > 0):
+            return self.skip(node, f"size {size.tolist()} is not positive on every axis")
+        return Box(size, center=self.flag(node, "center"))
 
-    def _sphere(self, node: Node) -> Solid:
-        r = self._radius(node, "r", "d", 1.0)
+    def _sphere(self, node: Node) -> Optional[Solid]:
+        r = self._radius(node, "r", "d", 1.0, empty_ok=True)
+        if not r > 0:
+            return self.skip(node, f"radius {r} is not positive")
         if not self.faceted:
             return Sphere(r)
         n = fx.fragments(r, *self.resolution(node))
         return _convex(fx.sphere_points(r, n))
 
-    def _radius(self, node: Node, rname: str, dname: str, default: float) -> float:
+    def _radius(self, node: Node, rname: str, dname: str, default: float,
+                empty_ok: bool = False) -> float:
+        """The radius from ``r`` or ``d``; with ``empty_ok`` 0 or below passes (the
+        caller skips the primitive)."""
         if dname in node.args and node.args[dname] is not None:
-            return self.number(node, dname, positive=True) / 2
-        return self.number(node, rname, default, positive=True)
+            return self.number(node, dname, positive=not empty_ok) / 2
+        return self.number(node, rname, default, positive=not empty_ok)
 
     def _cylinder(self, node: Node) -> Optional[Solid]:
-        h = self.number(node, "h", 1.0, positive=True)
+        h = self.number(node, "h", 1.0)
         r = self.arg(node, "r", None)
         r1 = self.number(node, "r1", r if r is not None else 1.0)
         r2 = self.number(node, "r2", r if r is not None else 1.0)
+        if not h > 0:
+            return self.skip(node, f"height {h} is not positive")
         if r1 < 0 or r2 < 0:
-            raise self.error(node, f"cylinder: radii must be >= 0, got r1={r1}, r2={r2}")
+            return self.skip(node, f"a radius is negative (r1={r1}, r2={r2})")
         if r1 == 0 and r2 == 0:
-            return None
+            return self.skip(node, "both radii are 0")
         center = self.flag(node, "center")
         if not self.faceted:
             return Cylinder(h=h, r1=r1, r2=r2, center=center)
@@ -271,7 +311,7 @@ class _Builder:
         n = fx.fragments(max(r1, r2), *self.resolution(node))
         return _convex(fx.cylinder_points(r1, r2, z1, z2, n))
 
-    def _polyhedron(self, node: Node) -> Solid:
+    def _polyhedron(self, node: Node) -> Optional[Solid]:
         pts = self.arg(node, "points", None, 0)
         faces = self.arg(node, "faces", None, 1)
         if faces is None:
@@ -283,13 +323,17 @@ class _Builder:
         if v.ndim != 2 or v.shape[1] != 3 or not np.all(np.isfinite(v)):
             raise self.error(node, "polyhedron: points must be a list of finite [x, y, z]")
         if not isinstance(faces, list) or not faces:
-            raise self.error(node, "polyhedron: faces must be a non-empty list of index lists")
+            return self.skip(node, "it has no faces")
         tris = []
         for k, face in enumerate(faces):
-            if not isinstance(face, list) or len(face) < 3 or not all(
-                    isinstance(i, float) and 0 <= i < len(v) and i == int(i) for i in face):
-                raise self.error(node, f"polyhedron: faces[{k}] must list >= 3 indices into "
-                                       f"points (0..{len(v) - 1})")
+            if not isinstance(face, list) or not all(isinstance(i, float) and math.isfinite(i)
+                                                     for i in face):
+                raise self.error(node, f"polyhedron: faces[{k}] must be a list of finite "
+                                       "indices")
+            if len(face) < 3 or not all(0 <= i < len(v) and i == int(i) for i in face):
+                return self.skip(node, f"faces[{k}] {face!r:.60} does not list 3 or more "
+                                       f"indices into points (0..{len(v) - 1}): the "
+                                       "polyhedron is invalid")
             idx = [int(i) for i in face]
             # OpenSCAD lists faces clockwise seen from outside: fan them reversed
             tris += [(idx[0], idx[j + 1], idx[j]) for j in range(1, len(idx) - 1)]
@@ -320,11 +364,18 @@ class _Builder:
         return Polygon(p, None if paths is None else [[int(i) for i in q] for q in paths])
 
     def _section(self, node: Node) -> Optional[Solid]:
-        """The 2D children of an extrusion, united (None when there are none)."""
-        body = self._group(node)
-        if body is not None and body.dim != 2:
-            raise self.error(node, f"{node.name}: the children must be 2D")
-        return body
+        """The 2D children of an extrusion, united (None when there are none); 3D
+        children are skipped with a warning, as OpenSCAD does."""
+        kids = []
+        for child in node.children:
+            built = self.build(child)
+            if built is not None and built.dim != 2:
+                self.skip(child, f"a 3D child of {node.name} (only 2D children are extruded)")
+            elif built is not None:
+                kids.append(built)
+        if not kids:
+            return None
+        return kids[0] if len(kids) == 1 else Union(*kids)
 
     def _linear_extrude(self, node: Node) -> Optional[Solid]:
         body = self._section(node)
@@ -378,6 +429,8 @@ class _Builder:
         if body is None:
             return None
         angle = self.number(node, "angle", 360.0)
+        if angle == 0:
+            return self.skip(node, "angle 0 sweeps no volume")
         if not self.faceted:
             return RotateExtrude(body, angle)
         b = body.bounds

@@ -47,6 +47,11 @@ class OpenSCADError(ValueError):
         super().__init__(f"{source}:{line}:{column}: {message}")
 
 
+class OpenSCADWarning(UserWarning):
+    """Degenerate ``.csg`` input that OpenSCAD skips (a zero-size cube, a singular
+    transform, ...): the reader skips it too and names it, with its location."""
+
+
 @dataclass
 class Token:
     kind: str        # "ident", "number", "string", "punct", "eof"
