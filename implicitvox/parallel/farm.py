@@ -120,7 +120,20 @@ def _died(done: int, count: int, what: str, cause: BaseException) -> WorkerError
                        "stopped. Out of memory? Lower the resolution or the workers.")
 
 
-class _OwnPool:
+class _Executor:
+    """A ``concurrent.futures`` executor's futures: completion and results."""
+
+    def completed(self, pending: dict) -> Iterator:
+        return _as_completed(pending)
+
+    def result(self, future, done: int, count: int, what: str):
+        try:
+            return future.result()
+        except BrokenProcessPool as err:
+            raise _died(done, count, what, err) from None
+
+
+class _OwnPool(_Executor):
     """A process pool of this machine, kept between runs; the job is pickled once
     into a file that each worker reads on its first piece (:func:`run_stored_piece`)."""
 
@@ -131,15 +144,6 @@ class _OwnPool:
 
     def submit(self, piece):
         return self.pool.submit(run_stored_piece, self.job.token, self.path, piece)
-
-    def completed(self, pending: dict) -> Iterator:
-        return _as_completed(pending)
-
-    def result(self, future, done: int, count: int, what: str):
-        try:
-            return future.result()
-        except BrokenProcessPool as err:
-            raise _died(done, count, what, err) from None
 
     def finish(self) -> None:
         """The run is over and every piece came back: the pool stays for the next."""
@@ -226,7 +230,7 @@ def pool_context():
     return _FORKSERVER
 
 
-class _Futures:
+class _Futures(_Executor):
     """Any ``concurrent.futures.Executor``: the job goes with each piece."""
 
     def __init__(self, job: Job, executor: Any):
@@ -236,15 +240,6 @@ class _Futures:
         future = self.executor.submit(run_piece, self.job, piece)
         self.futures.append(future)
         return future
-
-    def completed(self, pending: dict) -> Iterator:
-        return _as_completed(pending)
-
-    def result(self, future, done: int, count: int, what: str):
-        try:
-            return future.result()
-        except BrokenProcessPool as err:
-            raise _died(done, count, what, err) from None
 
     def finish(self) -> None:
         pass

@@ -1,0 +1,202 @@
+"""The real-client suite (issue 17): OpenSCAD's own examples, read and voxelized, against
+OpenSCAD's own STL.
+
+Run: ``python tests/benchmarks/bench_openscad.py [--resolution 128] [--timeout 300]
+[--only NAME ...]`` where Debian's ``openscad`` (2021.01) is installed.
+
+For every ``/usr/share/openscad/examples/**/*.scad``:
+
+1. the real OpenSCAD exports it (``-o X.csg`` and ``-o X.stl``, run from the
+   model's folder so its ``import``/``use`` resolve); the STL export's CPU time
+   is OpenSCAD's time. Exports are cached in ``~/.cache/implicitvox/openscad``.
+2. ``csg.read_openscad`` reads the ``.csg`` (``facets="openscad"`` and
+   ``"true"``); a refusal is reported with its message.
+3. The STL is voxelized exactly (``voxelize_mesh``) at ``--resolution`` over its
+   bounds, and the solid on the same lattice (``workers=1``: CPU time against
+   OpenSCAD's, one core each). With OpenSCAD's facets every STL voxel must be
+   in the output (``missed``; the STL's vertices are rounded to 6 digits, so a
+   voxel the STL only grazes within that rounding may count); an independent
+   check samples 20,000 points on the STL's triangles and counts those no output
+   voxel holds. With true curves, ``far`` counts STL voxels with no output voxel
+   within one voxel. ``ratio`` is output voxels over STL voxels.
+
+Each model runs in a child process with a timeout. Writes the table
+``openscad`` (the note of issue 17 quotes it).
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import resource
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+try:
+    from tests.benchmarks import tables
+except ImportError:        # run as a script from elsewhere
+    sys.path.insert(0, str(Path(__file__).resolve().parents[2]))
+    from tests.benchmarks import tables
+
+EXAMPLES = Path("/usr/share/openscad/examples")
+CACHE = Path.home() / ".cache" / "implicitvox" / "openscad"
+POINTS = 20_000
+
+
+def _export(scad: Path, timeout: float) -> dict:
+    """The model's .csg and .stl from the real OpenSCAD (cached), with the STL's CPU time."""
+    rel = scad.relative_to(EXAMPLES).with_suffix("")
+    out = CACHE / rel
+    out.mkdir(parents=True, exist_ok=True)
+    info_path = out / "export.json"
+    if info_path.exists():
+        return json.loads(info_path.read_text())
+    info = {"csg": str(out / "model.csg"), "stl": str(out / "model.stl")}
+    for kind in ("csg", "stl"):
+        before = resource.getrusage(resource.RUSAGE_CHILDREN)
+        t = time.perf_counter()
+        try:
+            done = subprocess.run(["openscad", "-o", info[kind], scad.name], cwd=scad.parent,
+                                  capture_output=True, text=True, timeout=timeout)
+            code, err = done.returncode, done.stderr
+        except subprocess.TimeoutExpired:
+            code, err = -1, f"timed out after {timeout:.0f} s"
+        after = resource.getrusage(resource.RUSAGE_CHILDREN)
+        info[f"{kind}_seconds"] = time.perf_counter() - t
+        info[f"{kind}_cpu"] = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
+        info[f"{kind}_ok"] = code == 0 and os.path.exists(info[kind]) and \
+            os.path.getsize(info[kind]) > 0
+        if not info[f"{kind}_ok"]:
+            lines = [ln for ln in err.splitlines() if "ERROR" in ln or "WARNING" in ln] or \
+                err.splitlines() or ["?"]
+            info[f"{kind}_error"] = lines[-1][:160]
+    info_path.write_text(json.dumps(info))
+    return info
+
+
+def child(csg_path: str, stl_path: str, res: int) -> dict:
+    """In a child process: read, voxelize both ways, compare (see the module docstring)."""
+    import warnings
+
+    import csg
+    import implicitvox as iv
+    from implicitvox.triangles.inputs import as_triangles
+    from tests.support.mesh_helpers import misses, sample_surface
+
+    warnings.simplefilter("ignore")
+    stl = iv.voxelize_mesh(stl_path, res, workers=1)
+    v, f = as_triangles(stl_path)
+    points = sample_surface(v[f], POINTS, np.random.default_rng(1))
+    out = {"stl_voxels": stl.count}
+    for mode in ("openscad", "true"):
+        try:
+            solid = csg.read_openscad(csg_path, facets=mode)
+        except (ValueError, TypeError, OSError) as err:
+            out[mode] = {"refused": str(err).split(": ", 1)[-1][:120]}
+            continue
+        t = time.process_time()
+        try:
+            vox = solid.voxelize(bounds=stl.bounds, voxel_size=stl.voxel_size, workers=1)
+        except (ValueError, MemoryError) as err:
+            out[mode] = {"refused": f"voxelize: {str(err)[:110]}"}
+            continue
+        cpu = time.process_time() - t
+        held = vox.contains(stl.coords())
+        row = {"cpu": cpu, "voxels": vox.count, "ratio": vox.count / max(stl.count, 1),
+               "missed": int((~held).sum()), "points_out": misses(vox, points)}
+        if mode == "true":
+            c = stl.coords()[~held].astype(np.int64)
+            near = np.zeros(len(c), dtype=bool)
+            for offset in np.stack(np.meshgrid(*[[-1, 0, 1]] * 3), -1).reshape(-1, 3):
+                q = c + offset
+                ok = np.all((q >= 0) & (q < np.asarray(vox.resolution)), axis=1)
+                near[ok] |= vox.contains(q[ok])
+            row["far"] = int((~near).sum())
+        out[mode] = row
+    return out
+
+
+def _run_child(csg_path: str, stl_path: str, res: int, timeout: float) -> dict:
+    try:
+        done = subprocess.run([sys.executable, __file__, "--child", csg_path, stl_path,
+                               str(res)], capture_output=True, text=True, timeout=timeout,
+                              cwd=Path(__file__).resolve().parents[2])
+    except subprocess.TimeoutExpired:
+        return {"error_text": f"over {timeout:.0f} s"}
+    if done.returncode != 0:
+        tail = (done.stderr.strip().splitlines() or ["?"])[-1]
+        return {"error_text": tail[:160]}
+    return json.loads(done.stdout.strip().splitlines()[-1])
+
+
+def _cell(row: dict, key: str, fmt: str = "{}") -> str:
+    return fmt.format(row[key]) if key in row else "-"
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--resolution", type=int, default=128)
+    parser.add_argument("--timeout", type=float, default=300)
+    parser.add_argument("--only", nargs="+", help="models whose path contains one of these")
+    parser.add_argument("--child", nargs=3, help=argparse.SUPPRESS)
+    args = parser.parse_args()
+    if args.child:
+        print(json.dumps(child(args.child[0], args.child[1], int(args.child[2]))))
+        return
+    load = tables.load_average()
+    models = sorted(EXAMPLES.rglob("*.scad"))
+    if args.only:
+        models = [m for m in models if any(k in str(m) for k in args.only)]
+    rows, summary = [], {"models": len(models), "3d": 0, "read": 0, "clean": 0,
+                         "ratios": [], "times": []}
+    for scad in models:
+        name = str(scad.relative_to(EXAMPLES).with_suffix(""))
+        info = _export(scad, args.timeout)
+        if not info.get("stl_ok"):
+            rows.append([name, "no 3D result: " + info.get("stl_error", "?")[:70]] + ["-"] * 8)
+            print(" | ".join(rows[-1]), flush=True)
+            continue
+        summary["3d"] += 1
+        if not info.get("csg_ok"):
+            rows.append([name, "no .csg export"] + ["-"] * 8)
+            continue
+        r = _run_child(info["csg"], info["stl"], args.resolution, args.timeout)
+        scad_cpu = info["stl_cpu"]
+        if "error_text" in r:
+            status, o, t = "error: " + r["error_text"][:80], {}, {}
+        else:
+            o, t = r["openscad"], r["true"]
+            status = "read" if "refused" not in o else "refused: " + o["refused"][:80]
+            if "refused" not in o:
+                summary["read"] += 1
+                summary["ratios"].append(o["ratio"])
+                summary["times"].append(o["cpu"] / max(scad_cpu, 1e-3))
+                if o["missed"] == 0 and o["points_out"] == 0:
+                    summary["clean"] += 1
+        rows.append([name, status, _cell(o, "missed"), _cell(o, "points_out"),
+                     _cell(o, "ratio", "{:.3f}"), _cell(o, "cpu", "{:.2f}"), f"{scad_cpu:.2f}",
+                     _cell(t, "far"), _cell(t, "ratio", "{:.3f}"), _cell(t, "cpu", "{:.2f}")])
+        print(" | ".join(rows[-1]), flush=True)
+    ratios, times = np.array(summary["ratios"]), np.array(summary["times"])
+    line = (f"{summary['models']} models, {summary['3d']} with a 3D result, {summary['read']} "
+            f"read, {summary['clean']} with no STL voxel or point missed (facets='openscad')")
+    if len(ratios):
+        line += (f"; voxel ratio median {np.median(ratios):.3f}, worst {ratios.max():.3f}; CPU "
+                 f"against OpenSCAD's STL export median {np.median(times):.2f}x, worst "
+                 f"{times.max():.1f}x")
+    print(line)
+    rows.append(["**all**", line] + [""] * 8)
+    header = ["model", "status", "missed STL voxels", f"points out (of {POINTS:,})",
+              "ratio", "CPU s", "OpenSCAD STL CPU s", "true: beyond 1 voxel", "true: ratio",
+              "true: CPU s"]
+    if not args.only:
+        tables.write("openscad", header, rows, "python tests/benchmarks/bench_openscad.py "
+                     + " ".join(sys.argv[1:]), load)
+
+
+if __name__ == "__main__":
+    main()
