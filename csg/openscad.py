@@ -2,11 +2,12 @@
 
 Supported modules: ``group, union, difference, intersection, multmatrix,
 cube, sphere, cylinder, polyhedron, circle, square, polygon, linear_extrude,
-rotate_extrude, color, render`` with ``$fn, $fa, $fs``, and OpenSCAD's
+rotate_extrude, color, render, import`` (triangle meshes: STL, PLY, OBJ, VTK)
+with ``$fn, $fa, $fs``, and OpenSCAD's
 modifiers as its ``.csg`` export writes them: ``%`` (background) and ``*``
 (disabled) drop their subtree, ``#`` (highlight) keeps it, ``!`` (root) makes
 its subtree the whole design. Any other module
-(``hull``, ``minkowski``, ``offset``, ``text``, ``import``, ``resize``, ...) is
+(``hull``, ``minkowski``, ``offset``, ``text``, ``resize``, ...) is
 refused with its name, line and column. Nothing is evaluated.
 
 Degenerate input is skipped, as OpenSCAD skips it, with an
@@ -46,10 +47,12 @@ import numpy as np
 from . import facets as fx
 from .openscad_parser import Node, OpenSCADError, OpenSCADWarning, parse
 from .planar import Circle, LinearExtrude, Polygon, Rectangle, RotateExtrude
+from implicitvox.triangles.inputs import MESH_SUFFIXES
+
 from .primitives import Box, ConvexPolyhedron, Cylinder, Polyhedron, Sphere
 from .solid import Difference, Intersection, Solid, Transformed, Union
 
-__all__ = ["read_openscad", "SUPPORTED", "UNSUPPORTED", "MAX_SLICES"]
+__all__ = ["read_openscad", "SUPPORTED", "UNSUPPORTED", "MAX_SLICES", "IMPORT_SUFFIXES"]
 
 #: slices of a twisted or scaled extrusion at most (OpenSCAD's own default is 1 per
 #: few degrees of twist: real models stay in the hundreds)
@@ -57,13 +60,15 @@ MAX_SLICES = 10_000
 
 SUPPORTED = ("group", "union", "difference", "intersection", "multmatrix", "cube", "sphere",
              "cylinder", "polyhedron", "circle", "square", "polygon", "linear_extrude",
-             "rotate_extrude", "color", "render")
+             "rotate_extrude", "color", "render", "import")
 #: OpenSCAD modules we know but do not voxelize
-UNSUPPORTED = ("hull", "minkowski", "offset", "text", "import", "resize", "surface",
+UNSUPPORTED = ("hull", "minkowski", "offset", "text", "resize", "surface",
                "projection", "roof", "mirror", "rotate", "translate", "scale")
+#: the files ``import`` reads: triangle meshes (:func:`implicitvox.triangles.inputs.as_triangles`)
+IMPORT_SUFFIXES = MESH_SUFFIXES
 
 
-def read_openscad(path_or_text: Any, facets: str = "true") -> Solid:
+def read_openscad(path_or_text: Any, facets: str = "true", base: Any = None) -> Solid:
     """Read a ``.csg`` file (path) or its text into a solid.
 
     Parameters
@@ -72,6 +77,11 @@ def read_openscad(path_or_text: Any, facets: str = "true") -> Solid:
         A path to a ``.csg`` file, or ``.csg`` text (anything containing ``(``).
     facets : {"true", "openscad"}
         Voxelize true curves, or OpenSCAD's facets.
+    base : str or os.PathLike, optional
+        The folder ``import(file = ...)`` paths are relative to: by default the
+        ``.csg`` file's own (OpenSCAD writes them relative to the ``.scad``
+        file's folder; pass that when the ``.csg`` was written elsewhere), or
+        the working directory for text.
 
     Raises
     ------
@@ -96,7 +106,9 @@ def read_openscad(path_or_text: Any, facets: str = "true") -> Solid:
     if root is not None:                 # "!": this subtree alone is the design
         nodes = [root]
         root.modifiers = root.modifiers.replace("!", "")
-    builder = _Builder(source, facets == "openscad")
+    if base is None:
+        base = os.path.dirname(os.path.abspath(source)) if source != "<csg>" else os.getcwd()
+    builder = _Builder(source, facets == "openscad", os.fspath(base))
     built = [(n, s) for n, s in ((n, builder.build(n)) for n in nodes) if s is not None]
     if not built:
         raise OpenSCADError("the file holds no geometry", 1, 1, source)
@@ -146,8 +158,8 @@ def _convex(points: np.ndarray) -> Solid:
 
 
 class _Builder:
-    def __init__(self, source: str, faceted: bool):
-        self.source, self.faceted = source, faceted
+    def __init__(self, source: str, faceted: bool, base: str = "."):
+        self.source, self.faceted, self.base = source, faceted, base
 
     def error(self, node: Node, message: str) -> OpenSCADError:
         return OpenSCADError(message, node.line, node.column, self.source)
@@ -338,6 +350,22 @@ class _Builder:
             # OpenSCAD lists faces clockwise seen from outside: fan them reversed
             tris += [(idx[0], idx[j + 1], idx[j]) for j in range(1, len(idx) - 1)]
         return Polyhedron(v, np.array(tris, dtype=np.int64))
+
+    def _import(self, node: Node) -> Optional[Solid]:
+        """A triangle mesh file, as OpenSCAD imports it: the same solid in both facet
+        modes (a closed mesh, classified exactly); a missing file is skipped with a
+        warning, as OpenSCAD skips it."""
+        name = self.arg(node, "file", None, 0)
+        if not isinstance(name, str) or not name:
+            raise self.error(node, f"import: file must be a file name, got {name!r:.60}")
+        path = name if os.path.isabs(name) else os.path.join(self.base, name)
+        suffix = os.path.splitext(name)[1].lower()
+        if suffix not in IMPORT_SUFFIXES:
+            raise self.error(node, f"import: {suffix or 'this'} files are not read (meshes: "
+                                   f"{', '.join(IMPORT_SUFFIXES)})")
+        if not os.path.isfile(path):
+            return self.skip(node, f"cannot open {path!r}")
+        return Polyhedron(path)
 
     def _circle(self, node: Node) -> Solid:
         r = self._radius(node, "r", "d", 1.0)

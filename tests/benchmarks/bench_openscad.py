@@ -10,7 +10,8 @@ For every ``/usr/share/openscad/examples/**/*.scad``:
    model's folder so its ``import``/``use`` resolve); the STL export's CPU time
    is OpenSCAD's time. Exports are cached in ``~/.cache/implicitvox/openscad``.
 2. ``csg.read_openscad`` reads the ``.csg`` (``facets="openscad"`` and
-   ``"true"``); a refusal is reported with its message.
+   ``"true"``; ``import`` paths relative to the model's folder); a refusal is
+   reported with its message.
 3. The STL is voxelized exactly (``voxelize_mesh``) at ``--resolution`` over its
    bounds, and the solid on the same lattice (``workers=1``: CPU time against
    OpenSCAD's, one core each). With OpenSCAD's facets every STL voxel must be
@@ -78,7 +79,7 @@ def _export(scad: Path, timeout: float) -> dict:
     return info
 
 
-def child(csg_path: str, stl_path: str, res: int) -> dict:
+def child(csg_path: str, stl_path: str, res: int, base: str) -> dict:
     """In a child process: read, voxelize both ways, compare (see the module docstring)."""
     import warnings
 
@@ -94,7 +95,7 @@ def child(csg_path: str, stl_path: str, res: int) -> dict:
     out = {"stl_voxels": stl.count}
     for mode in ("openscad", "true"):
         try:
-            solid = csg.read_openscad(csg_path, facets=mode)
+            solid = csg.read_openscad(csg_path, facets=mode, base=base)
         except (ValueError, TypeError, OSError) as err:
             out[mode] = {"refused": str(err).split(": ", 1)[-1][:120]}
             continue
@@ -120,10 +121,10 @@ def child(csg_path: str, stl_path: str, res: int) -> dict:
     return out
 
 
-def _run_child(csg_path: str, stl_path: str, res: int, timeout: float) -> dict:
+def _run_child(csg_path: str, stl_path: str, res: int, base: str, timeout: float) -> dict:
     try:
         done = subprocess.run([sys.executable, __file__, "--child", csg_path, stl_path,
-                               str(res)], capture_output=True, text=True, timeout=timeout,
+                               str(res), base], capture_output=True, text=True, timeout=timeout,
                               cwd=Path(__file__).resolve().parents[2])
     except subprocess.TimeoutExpired:
         return {"error_text": f"over {timeout:.0f} s"}
@@ -142,10 +143,11 @@ def main() -> None:
     parser.add_argument("--resolution", type=int, default=128)
     parser.add_argument("--timeout", type=float, default=300)
     parser.add_argument("--only", nargs="+", help="models whose path contains one of these")
-    parser.add_argument("--child", nargs=3, help=argparse.SUPPRESS)
+    parser.add_argument("--child", nargs=4, help=argparse.SUPPRESS)
     args = parser.parse_args()
     if args.child:
-        print(json.dumps(child(args.child[0], args.child[1], int(args.child[2]))))
+        print(json.dumps(child(args.child[0], args.child[1], int(args.child[2]),
+                               args.child[3])))
         return
     load = tables.load_average()
     models = sorted(EXAMPLES.rglob("*.scad"))
@@ -164,7 +166,8 @@ def main() -> None:
         if not info.get("csg_ok"):
             rows.append([name, "no .csg export"] + ["-"] * 8)
             continue
-        r = _run_child(info["csg"], info["stl"], args.resolution, args.timeout)
+        r = _run_child(info["csg"], info["stl"], args.resolution, str(scad.parent),
+                       args.timeout)
         scad_cpu = info["stl_cpu"]
         if "error_text" in r:
             status, o, t = "error: " + r["error_text"][:80], {}, {}

@@ -67,3 +67,32 @@ def test_bad_values_are_still_errors():
     """Degenerate is not malformed: a radius that is no number is still refused."""
     with pytest.raises(csg.OpenSCADError, match="sphere: r must be a finite number"):
         csg.read_openscad('sphere(r = "one");')
+
+
+def test_import_of_a_mesh_relative_to_the_csg_file(tmp_path):
+    """``import`` reads the mesh the path names, relative to the .csg file's folder (or
+    ``base``); its voxels are exactly the mesh's."""
+    import pyvista as pv
+    mesh = pv.Icosphere(radius=1.0, nsub=2).translate((0.1, 0.2, 0.3))
+    models = tmp_path / "models"
+    models.mkdir()
+    mesh.save(str(models / "ball.stl"))
+    text = 'multmatrix([[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]]) {\n' \
+           '  import(file = "ball.stl", layer = "", origin = [0, 0], scale = 1, ' \
+           'convexity = 1, $fn = 0, $fa = 12, $fs = 2, timestamp = 1);\n}\n'
+    (models / "model.csg").write_text(text)
+    solid = csg.read_openscad(str(models / "model.csg"))
+    elsewhere = csg.read_openscad(text, base=models)
+    exact = iv.voxelize_mesh(str(models / "ball.stl"), 32, workers=1)
+    for s in (solid, elsewhere):
+        vox = s.voxelize(bounds=exact.bounds, voxel_size=exact.voxel_size, workers=1)
+        assert np.array_equal(vox.coords(), exact.coords())
+
+
+def test_import_of_a_missing_or_unread_file(tmp_path):
+    with pytest.warns(csg.OpenSCADWarning, match=r"<csg>:2:3: import: cannot open .*gone.stl"):
+        solid = csg.read_openscad('union() {\n  import(file = "gone.stl");\n  cube(size = 1);\n}',
+                                  base=tmp_path)
+    assert solid.bounds == ((0.0, 0.0, 0.0), (1.0, 1.0, 1.0))
+    with pytest.raises(csg.OpenSCADError, match=r"import: \.dxf files are not read"):
+        csg.read_openscad('import(file = "part.dxf");', base=tmp_path)
