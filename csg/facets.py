@@ -38,10 +38,14 @@ from implicitvox import Expr, x, y
 
 from .triangulate import triangulate
 
-__all__ = ["fragments", "circle_points", "sphere_points", "cylinder_points",
+__all__ = ["fragments", "helix_slices", "conical_helix_slices", "diagonal_slices",
+           "extrusion_slices", "circle_points", "sphere_points", "cylinder_points",
            "polygonal_radius", "extrusion_mesh", "MAX_FRAGMENTS", "MAX_SPHERE_POINTS"]
 
 GRID_FINE = 0.00000095367431640625
+#: side-quad diagonals whose squared lengths differ by at most this share are equal
+#: to OpenSCAD (:func:`extrusion_mesh`)
+DIAGONAL_TIE = 1e-5
 
 
 #: fragments per circle at most ($fn = 10000 is far beyond what a model needs; an OpenSCAD
@@ -70,6 +74,89 @@ def fragments(r: float, fn: float = 0.0, fs: float = 2.0, fa: float = 12.0) -> i
         raise ValueError(f"$fn/$fa/$fs ask for {n:.4g} fragments per circle, over the limit "
                          f"of {MAX_FRAGMENTS} (csg.facets.MAX_FRAGMENTS)")
     return int(n)
+
+
+def helix_slices(r_sqr: float, height: float, twist: float, fn: float, fs: float,
+                 fa: float) -> int:
+    """OpenSCAD 2021.01's slices of a twisted ``linear_extrude`` without ``slices``
+    (``Calc::get_helix_slices``): 3 per turn at least; ``$fn`` per turn; else the
+    fewer of ``twist / $fa`` and the helix's length over ``$fs``, for the vertex
+    ``sqrt(r_sqr)`` from the axis.
+
+    >>> helix_slices(89.0, 10.0, 90.0, 0.0, 2.0, 12.0), helix_slices(89.0, 10.0, 90.0, 16, 2, 12)
+    (8, 4)
+    """
+    twist = abs(twist)
+    least = max(int(math.ceil(twist / 120.0)), 1)
+    if math.sqrt(r_sqr) < GRID_FINE or not math.isfinite(fn):
+        return least
+    if fn > 0:
+        return max(int(math.ceil(twist / 360.0 * fn)), least)
+    turn = math.radians(twist)
+    length = turn * math.sqrt(r_sqr + (height / turn) ** 2) if turn > 0 else height
+    return max(min(int(math.ceil(twist / fa)), int(math.ceil(length / fs))), least)
+
+
+def conical_helix_slices(r_sqr: float, height: float, twist: float, scale: float, fn: float,
+                         fs: float, fa: float) -> int:
+    """``Calc::get_conical_helix_slices``: a twist with a uniform scale; the vertex
+    runs on a section of an Archimedes spiral, whose length (with the height)
+    over ``$fs`` bounds the slices.
+
+    >>> conical_helix_slices(89.0, 10.0, 720.0, 0.5, 0.0, 2.0, 12.0)
+    45
+    """
+    twist = abs(twist)
+    r = math.sqrt(r_sqr)
+    least = max(int(math.ceil(twist / 120.0)), 1)
+    if r < GRID_FINE or not math.isfinite(fn):
+        return least
+    if fn > 0:
+        return max(int(math.ceil(twist * fn / 360)), least)
+    turn = math.radians(twist)
+    end = turn * scale / (scale - 1) if scale > 1 else turn / (1 - scale)
+    start = end - turn
+    a = r / end
+
+    def spiral(theta: float) -> float:
+        return 0.5 * a * (theta * math.sqrt(1 + theta * theta) + math.asinh(theta))
+
+    length = math.hypot(spiral(end) - spiral(start), height)
+    return max(min(int(math.ceil(twist / fa)), int(math.ceil(length / fs))), least)
+
+
+def diagonal_slices(delta_sqr: float, height: float, fn: float, fs: float) -> int:
+    """``Calc::get_diagonal_slices``: a non-uniform scale without twist; ``$fn``
+    slices, else the longest vertex path over ``$fs``."""
+    if math.sqrt(delta_sqr) < GRID_FINE or not math.isfinite(fn):
+        return 1
+    if fn > 0:
+        return max(int(fn), 1)
+    return max(int(math.ceil(math.sqrt(delta_sqr + height * height) / fs)), 1)
+
+
+def extrusion_slices(points: np.ndarray, height: float, twist: float, scale: np.ndarray,
+                     fn: float, fs: float, fa: float, twisted: bool) -> int:
+    """The slices OpenSCAD 2021.01 cuts a ``linear_extrude`` into when the file gives
+    none, from the section's vertices ``points (n, 2)`` (``twisted``: the file
+    gives ``twist``): the helix (no scale, or an uneven one), the conical helix
+    (a uniform scale), the diagonal (an uneven scale without twist), or one.
+
+    >>> square = np.array([[3.0, 0], [8, 0], [8, 5], [3, 5]])
+    >>> extrusion_slices(square, 10.0, 90.0, np.array([1.0, 1.0]), 0.0, 2.0, 12.0, True)
+    8
+    """
+    sx, sy = float(scale[0]), float(scale[1])
+    if twisted:
+        r_sqr = float(np.max(np.einsum("ij,ij->i", points, points))) if len(points) else 0.0
+        if (sx == 1.0 and sy == 1.0) or sx != sy:
+            return helix_slices(r_sqr, height, twist, fn, fs, fa)
+        return conical_helix_slices(r_sqr, height, twist, sx, fn, fs, fa)
+    if sx != sy:
+        delta = points - points * np.array([sx, sy])
+        delta_sqr = float(np.max(np.einsum("ij,ij->i", delta, delta))) if len(points) else 0.0
+        return diagonal_slices(delta_sqr, height, fn, fs)
+    return 1
 
 
 def _cos_sin_degrees(deg: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -162,10 +249,13 @@ def extrusion_mesh(outline: np.ndarray, height: float, twist: float, scale: np.n
         a, b = i * k, (i + 1) * k
         for j in range(k):
             j1 = (j + 1) % k
-            # OpenSCAD splits a side quad along its shorter diagonal
+            # OpenSCAD splits a side quad along its shorter diagonal; diagonals within a
+            # relative 1e-5 of each other are a tie, which the twist's direction decides
+            # (measured against OpenSCAD 2021.01's STL: tests/csg/test_openscad_degenerate.py)
             d1 = np.sum((verts[a + j] - verts[b + j1]) ** 2)
             d2 = np.sum((verts[a + j1] - verts[b + j]) ** 2)
-            if d1 <= d2:
+            tie = abs(d1 - d2) <= DIAGONAL_TIE * max(d1, d2)
+            if (twist >= 0) if tie else d1 < d2:
                 faces.append((a + j, a + j1, b + j1))
                 faces.append((a + j, b + j1, b + j))
             else:

@@ -415,13 +415,43 @@ class _Builder:
         center = self.flag(node, "center")
         if not self.faceted or (twist == 0 and scale[0] == scale[1]):
             return LinearExtrude(body, h, twist, scale, center)
-        slices = self.number(node, "slices", 1.0)
+        if node.args.get("slices") is not None:
+            slices = self.number(node, "slices", 1.0)
+        else:                                  # OpenSCAD computes them (calc.cc)
+            fn, fs, fa = self.resolution(node)
+            slices = fx.extrusion_slices(self._outline_points(node, body), h, twist, scale,
+                                         fn, fs, fa, twisted="twist" in node.args)
         if not slices <= MAX_SLICES:
             raise self.error(node, f"linear_extrude: slices = {slices:.4g}, over the limit of "
                                    f"{MAX_SLICES} (csg.openscad.MAX_SLICES)")
         slices = max(int(slices), 1)
         return self._extrude_tree(node, body, np.eye(4), (h, twist, scale, slices,
                                                          -h / 2 if center else 0.0))
+
+    def _outline_points(self, node: Node, body: Solid, matrix: Optional[np.ndarray] = None
+                        ) -> np.ndarray:
+        """Every vertex (n, 2) of the outlines of a 2D tree, placed. OpenSCAD takes
+        them from the section after its 2D booleans, which may drop a vertex (one a
+        difference cuts away) or add one (where outlines cross): where that vertex
+        is the farthest from the axis, its slice count differs."""
+        matrix = np.eye(4) if matrix is None else matrix
+        if isinstance(body, Transformed):
+            return self._outline_points(node, body.children[0], matrix @ body.matrix)
+        if isinstance(body, (Union, Intersection, Difference)):
+            return np.concatenate([self._outline_points(node, c, matrix) for c in body.children])
+        points = np.concatenate(self._outlines(node, body))
+        return points @ matrix[:2, :2].T + matrix[:2, 3]
+
+    def _outlines(self, node: Node, body: Solid) -> list[np.ndarray]:
+        """The outlines (each (m, 2)) of a 2D leaf in OpenSCAD's facets."""
+        if isinstance(body, Rectangle):
+            lo = -body.size / 2 if body.centered else np.zeros(2)
+            hi = lo + body.size
+            return [np.array([[lo[0], lo[1]], [hi[0], lo[1]], [hi[0], hi[1]], [lo[0], hi[1]]])]
+        if isinstance(body, Polygon):
+            return [body.points[p] for p in body.paths]
+        raise self.error(node, f"facets='openscad': cannot extrude a {type(body).__name__} "
+                               "with twist or an uneven scale (use facets='true')")
 
     def _extrude_tree(self, node: Node, body: Solid, matrix: np.ndarray, params) -> Solid:
         """OpenSCAD's sliced extrusion of a 2D CSG tree: each leaf outline is extruded as
@@ -435,16 +465,7 @@ class _Builder:
         if isinstance(body, (Union, Intersection, Difference)):
             kids = [self._extrude_tree(node, c, matrix, params) for c in body.children]
             return type(body)(*kids)
-        if isinstance(body, Rectangle):
-            lo = -body.size / 2 if body.centered else np.zeros(2)
-            hi = lo + body.size
-            outlines = [np.array([[lo[0], lo[1]], [hi[0], lo[1]], [hi[0], hi[1]],
-                                  [lo[0], hi[1]]])]
-        elif isinstance(body, Polygon):
-            outlines = [body.points[p] for p in body.paths]
-        else:
-            raise self.error(node, f"facets='openscad': cannot extrude a {type(body).__name__} "
-                                   "with twist or an uneven scale (use facets='true')")
+        outlines = self._outlines(node, body)
         meshes = []
         for pts in outlines:
             moved = pts @ matrix[:2, :2].T + matrix[:2, 3]
