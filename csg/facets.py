@@ -224,11 +224,15 @@ def polygonal_radius(n_sectors: int, angle: float) -> Expr:
 
 
 def extrusion_mesh(outline: np.ndarray, height: float, twist: float, scale: np.ndarray,
-                   slices: int, z0: float) -> tuple[np.ndarray, np.ndarray]:
+                   slices: int, z0: float, extend: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
     """Vertices and triangles of OpenSCAD's linear extrusion of one polygon outline.
 
     Layer ``i`` is the outline turned by ``-twist i / slices`` degrees, then scaled by
-    ``1 + (scale - 1) i / slices``, at ``z0 + height i / slices``.
+    ``1 + (scale - 1) i / slices``, at ``z0 + height i / slices``. ``extend`` (a share
+    of the height) continues the end layers straight on beyond both ends, the walls
+    between the ends unchanged: a hole cut with it has no cap in or near the plane
+    of the solid's caps (coincident faces would leave a false layer of surface
+    voxels there).
     """
     poly = np.asarray(outline, dtype=np.float64)
     area = 0.5 * np.sum(poly[:, 0] * np.roll(poly[:, 1], -1) - np.roll(poly[:, 0], -1) * poly[:, 1])
@@ -236,16 +240,22 @@ def extrusion_mesh(outline: np.ndarray, height: float, twist: float, scale: np.n
         poly = poly[::-1]
     k = len(poly)
     layers = []
-    for i in range(slices + 1):
-        t = i / slices
+    steps = [i / slices for i in range(slices + 1)]
+    for t in steps:
         sx, sy = 1 + (scale[0] - 1) * t, 1 + (scale[1] - 1) * t
         c, s = _cos_sin_degrees(-twist * t)
         # OpenSCAD turns the section, then scales it: v = S R p
         rx, ry = c * poly[:, 0] - s * poly[:, 1], s * poly[:, 0] + c * poly[:, 1]
         layers.append(np.column_stack([rx * sx, ry * sy, np.full(k, z0 + height * t)]))
+    if extend > 0:
+        below, above = layers[0].copy(), layers[-1].copy()
+        below[:, 2] -= extend * height
+        above[:, 2] += extend * height
+        layers = [below] + layers + [above]
+        steps = [-extend] + steps + [1 + extend]
     verts = np.concatenate(layers)
     faces = []
-    for i in range(slices):
+    for i in range(len(steps) - 1):
         a, b = i * k, (i + 1) * k
         for j in range(k):
             j1 = (j + 1) % k
@@ -263,6 +273,6 @@ def extrusion_mesh(outline: np.ndarray, height: float, twist: float, scale: np.n
                 faces.append((a + j1, b + j1, b + j))
     cap = triangulate(poly)
     faces += [(c, b_, a_) for a_, b_, c in cap]                       # bottom, facing down
-    top = slices * k
+    top = (len(steps) - 1) * k
     faces += [(top + a_, top + b_, top + c) for a_, b_, c in cap]     # top, facing up
     return verts, np.array(faces, dtype=np.int64)

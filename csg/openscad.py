@@ -64,6 +64,9 @@ SUPPORTED = ("group", "union", "difference", "intersection", "multmatrix", "cube
 #: OpenSCAD modules we know but do not voxelize
 UNSUPPORTED = ("hull", "minkowski", "offset", "text", "resize", "surface",
                "projection", "roof", "mirror", "rotate", "translate", "scale")
+#: how far (a share of the height) the prism of a hole runs past the caps of the twisted
+#: or scaled extrusion it is cut from (:func:`csg.facets.extrusion_mesh`)
+HOLE_EXTEND = 1.0
 #: the files ``import`` reads: triangle meshes (:func:`implicitvox.triangles.inputs.as_triangles`)
 IMPORT_SUFFIXES = MESH_SUFFIXES
 
@@ -443,13 +446,15 @@ class _Builder:
         return points @ matrix[:2, :2].T + matrix[:2, 3]
 
     def _outlines(self, node: Node, body: Solid) -> list[np.ndarray]:
-        """The outlines (each (m, 2)) of a 2D leaf in OpenSCAD's facets."""
+        """The outlines (each (m, 2)) of a 2D leaf in OpenSCAD's facets; a polygon's
+        in the order of its even-odd pieces (:attr:`Polygon.pieces`)."""
         if isinstance(body, Rectangle):
             lo = -body.size / 2 if body.centered else np.zeros(2)
             hi = lo + body.size
             return [np.array([[lo[0], lo[1]], [hi[0], lo[1]], [hi[0], hi[1]], [lo[0], hi[1]]])]
         if isinstance(body, Polygon):
-            return [body.points[p] for p in body.paths]
+            return [body.points[body.paths[k]] for piece in body.pieces
+                    for k in (piece[0], *piece[1])]
         raise self.error(node, f"facets='openscad': cannot extrude a {type(body).__name__} "
                                "with twist or an uneven scale (use facets='true')")
 
@@ -465,13 +470,22 @@ class _Builder:
         if isinstance(body, (Union, Intersection, Difference)):
             kids = [self._extrude_tree(node, c, matrix, params) for c in body.children]
             return type(body)(*kids)
-        outlines = self._outlines(node, body)
-        meshes = []
-        for pts in outlines:
-            moved = pts @ matrix[:2, :2].T + matrix[:2, 3]
-            v, f = fx.extrusion_mesh(moved, *params)
-            meshes.append(Polyhedron(v, f))
-        return meshes[0] if len(meshes) == 1 else Difference(meshes[0], *meshes[1:])
+        def prism(pts: np.ndarray, extend: float = 0.0) -> Solid:
+            v, f = fx.extrusion_mesh(pts @ matrix[:2, :2].T + matrix[:2, 3], *params,
+                                     extend=extend)
+            return Polyhedron(v, f)
+
+        if isinstance(body, Polygon):          # even-odd: each piece minus its holes
+            pieces = []
+            for outer, holes in body.pieces:
+                solid = prism(body.points[body.paths[outer]])
+                if holes:
+                    # holes reach past the caps: no coincident cap faces
+                    solid = Difference(solid, *[prism(body.points[body.paths[h]], HOLE_EXTEND)
+                                                for h in holes])
+                pieces.append(solid)
+            return pieces[0] if len(pieces) == 1 else Union(*pieces)
+        return prism(self._outlines(node, body)[0])
 
     def _rotate_extrude(self, node: Node) -> Optional[Solid]:
         body = self._section(node)

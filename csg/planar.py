@@ -119,12 +119,45 @@ def _max_of_edges(poly: np.ndarray, order) -> Expr:
     return iv.max(*edges) if len(edges) > 1 else edges[0]
 
 
-class Polygon(Shape2D):
-    """A polygon from ``points`` (k, 2); ``paths`` (lists of point indices) give an outline
-    and holes, as in OpenSCAD (the first path is the outline, the others are cut out).
+def _even_odd_pieces(points: np.ndarray, paths: list[list[int]]) -> list[tuple[int, list[int]]]:
+    """Nest non-crossing paths by containment (a path is inside another when most of
+    its vertices are: a shared vertex does not decide) and pair each even-depth path
+    with the paths one level deeper directly inside it."""
+    from skimage.measure import points_in_poly
+    n = len(paths)
+    inside = np.zeros((n, n), dtype=bool)             # inside[a, b]: path a lies in path b
+    for b_, outline in enumerate(paths):
+        poly = points[outline]
+        for a_, path in enumerate(paths):
+            if a_ != b_:
+                inside[a_, b_] = points_in_poly(points[path], poly).mean() > 0.5
+    depth = inside.sum(axis=1)
+    pieces = []
+    for k in np.flatnonzero(depth % 2 == 0):
+        holes = [int(h) for h in np.flatnonzero(inside[:, k] & (depth == depth[k] + 1))]
+        pieces.append((int(k), holes))
+    return pieces
 
-    The region is a union of the ear-clipping triangles of each path: its
-    function is exact in sign.
+
+class Polygon(Shape2D):
+    """A polygon from ``points`` (k, 2); ``paths`` (lists of point indices) are filled as
+    OpenSCAD fills them, even-odd: a point is inside when an odd number of paths
+    enclose it (an outline, its holes, islands in the holes, ...).
+
+    Each path's region is a union of its ear-clipping triangles; paths are
+    nested by containment (they must not cross, as OpenSCAD's own polygons do
+    not), and each path at an even depth minus the paths directly inside it is
+    one piece of the region (:attr:`pieces`): its function is exact in sign.
+
+    Examples
+    --------
+    An outline, a hole in it and an island in the hole (the dot of an "i" in an "o"):
+
+    >>> square = lambda c, h: [[c - h, c - h], [c + h, c - h], [c + h, c + h], [c - h, c + h]]
+    >>> p = Polygon(square(0, 3) + square(0, 2) + square(0, 1),
+    ...             [[0, 1, 2, 3], [4, 5, 6, 7], [8, 9, 10, 11]])
+    >>> p.pieces
+    [(0, [1]), (2, [])]
     """
 
     def __init__(self, points: Any, paths: Optional[Sequence[Sequence[int]]] = None):
@@ -139,6 +172,9 @@ class Polygon(Shape2D):
             if len(p) < 3 or min(p) < 0 or max(p) >= len(pts):
                 raise ValueError(f"paths[{i}] must list at least 3 indices into points")
         self._regions = [self._path_expr(p) for p in self.paths]
+        #: the region as pieces ``(path, [paths directly inside it])``: each path at an
+        #: even depth of the nesting, minus those one level deeper inside it
+        self.pieces = _even_odd_pieces(pts, self.paths)
 
     def _path_expr(self, path: list[int]) -> Expr:
         poly = self.points[path]
@@ -161,14 +197,13 @@ class Polygon(Shape2D):
 
     @property
     def expr(self) -> Expr:
-        outline = self._regions[0]
-        if len(self._regions) == 1:
-            return outline
-        return iv.max(outline, *[-h for h in self._regions[1:]])
+        pieces = [iv.max(self._regions[outer], *[-self._regions[h] for h in holes])
+                  if holes else self._regions[outer] for outer, holes in self.pieces]
+        return pieces[0] if len(pieces) == 1 else iv.min(*pieces)
 
     @property
     def bounds(self) -> Bounds:
-        used = self.points[sorted({i for p in self.paths[:1] for i in p})]
+        used = self.points[sorted({i for k, _ in self.pieces for i in self.paths[k]})]
         lo, hi = used.min(axis=0), used.max(axis=0)
         return (float(lo[0]), float(lo[1]), 0.0), (float(hi[0]), float(hi[1]), 0.0)
 
