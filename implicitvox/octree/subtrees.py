@@ -77,7 +77,8 @@ class SubtreeResult:
     tapes_built: int = 0
     #: runs ``(count, tape)`` of the pruned tapes over ``codes`` (when asked for)
     tapes: list = field(default_factory=list)
-    #: without ``tapes``: the subtrees' part of the octree (:func:`~implicitvox.octree.store.subtree_masks`
+    #: without ``tapes``: the subtrees' part of the octree
+    #: (:func:`~implicitvox.octree.store.subtree_masks`
     #: of the sorted codes at the job's level); ``codes`` are then not sent back
     octree: Optional[tuple] = None
     #: surface voxels found

@@ -68,7 +68,8 @@ def _export(scad: Path, timeout: float) -> dict:
             code, err = -1, f"timed out after {timeout:.0f} s"
         after = resource.getrusage(resource.RUSAGE_CHILDREN)
         info[f"{kind}_seconds"] = time.perf_counter() - t
-        info[f"{kind}_cpu"] = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
+        info[f"{kind}_cpu"] = (after.ru_utime - before.ru_utime) + \
+            (after.ru_stime - before.ru_stime)
         info[f"{kind}_ok"] = code == 0 and os.path.exists(info[kind]) and \
             os.path.getsize(info[kind]) > 0
         if not info[f"{kind}_ok"]:

@@ -32,7 +32,8 @@ BOUNDS = ((-1.5,) * 3, (1.5,) * 3)
 ])
 def test_skipped_with_a_warning_and_the_rest_read(degenerate, says):
     text = f"group() {{\n  {REST}\n  {degenerate}\n}}\n"
-    with pytest.warns(csg.OpenSCADWarning, match=rf"<csg>:3:3: {re.escape(says)}.*skipped, as OpenSCAD"):
+    expected = rf"<csg>:3:3: {re.escape(says)}.*skipped, as OpenSCAD"
+    with pytest.warns(csg.OpenSCADWarning, match=expected):
         solid = csg.read_openscad(text)
     with warnings.catch_warnings():
         warnings.simplefilter("error")          # the rest alone: no warning
