@@ -212,8 +212,9 @@ def subdivide_in_parallel(shape: Any, func: Function, grid: Grid, options: dict,
                             executor=executor, weights=[b - a for a, b in ranges],
                             progress=progress, what=what):
         parts[index] = part
-        codes.append(part.codes)
-        runs.extend(part.tapes)
+        if tapes:                                  # else the codes stay in the workers
+            codes.append(part.codes)
+            runs.extend(part.tapes)
         for lvl, c in part.interior.items():
             interior.setdefault(lvl, []).append(c)
         evaluated += part.evaluated

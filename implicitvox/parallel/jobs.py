@@ -114,7 +114,6 @@ def store_job(job: Job) -> str:
 def run_stored_piece(token: str, path: str, piece: Any) -> Any:
     """Run one piece of the job stored at ``path`` (read once per worker process)."""
     if token not in _INSTALLED:
-        tune_allocator()
         with open(path, "rb") as stored:
             install(pickle.load(stored))
     return run_piece(token, piece)

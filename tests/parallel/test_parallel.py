@@ -159,10 +159,10 @@ class Crash(Job):
 
 
 def test_a_dead_worker_is_reported_not_waited_for():
-    t0 = time.perf_counter()
+    # the error itself is the check: a farm that waited for the dead worker would never
+    # return (no time is asserted here)
     with pytest.raises(WorkerError, match=r"a worker died while testing \([0-3] of 4 pieces done"):
         list(farm(Crash(), [0, 1, 2, 3], workers=2, what="testing"))
-    assert time.perf_counter() - t0 < 30      # a hang bound (reported, not waited for), not a speed
 
 
 class Fail(Job):
