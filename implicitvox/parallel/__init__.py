@@ -10,18 +10,19 @@ result is bit-identical to the serial run for any number of workers and any
 schedule.
 
 The same code path serves one machine and a cluster: ``workers=n`` starts a
-pool of ``n`` processes of this machine (``forkserver``); ``executor=`` takes
+pool of ``n`` processes of this machine (forked, or from a ``forkserver``: see
+:func:`~implicitvox.parallel.farm.pool_context`); ``executor=`` takes
 any ``concurrent.futures.Executor`` or a ``dask.distributed.Client`` (Dask is
 the distributed engine; nothing here schedules or talks over a network).
 This layer knows nothing of octrees: each algorithm defines its job next to
 itself (:mod:`implicitvox.octree.subtrees`, :mod:`implicitvox.triangles.pairs`,
 ...).
 """
-from .farm import WorkerError, farm
+from .farm import SCATTER_BYTES, WorkerError, farm
 from .jobs import Job, run_piece
 from .plan import (MIN_PARALLEL_WORK, PIECES_PER_WORKER, WORK_PER_PIECE, WORKERS_VARIABLE,
                    available_cores, executor_workers, pieces_for, plan_workers, split_evenly)
 
 __all__ = ["farm", "WorkerError", "Job", "run_piece", "available_cores", "executor_workers",
            "plan_workers", "pieces_for", "split_evenly", "MIN_PARALLEL_WORK", "PIECES_PER_WORKER",
-           "WORK_PER_PIECE", "WORKERS_VARIABLE"]
+           "WORK_PER_PIECE", "WORKERS_VARIABLE", "SCATTER_BYTES"]

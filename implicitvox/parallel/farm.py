@@ -8,10 +8,12 @@ Three backends behind one generator, :func:`farm`:
   kept for the next run (starting workers costs more than a small run); the
   job is pickled once into a file (in ``/dev/shm`` where there is one) that
   each worker reads on its first piece: it travels once per worker.
-* ``executor=`` a ``dask.distributed.Client``: the job is ``scatter``-ed to
+* ``executor=`` a ``dask.distributed.Client``: a job larger than
+  :data:`SCATTER_BYTES` pickled (a mesh's triangles) is ``scatter``-ed to
   every worker (``broadcast=True``) and each piece is a task reading it
-  there; Dask retries a piece whose worker died and then reports it
-  (``KilledWorker``).
+  there; a smaller one (an expression's tape: a few KiB) goes with each task,
+  which saves the broadcast's round trip to every worker; Dask retries a
+  piece whose worker died and then reports it (``KilledWorker``).
 * ``executor=`` any other ``concurrent.futures.Executor`` (a thread pool, a
   process pool of your own, an MPI pool): the job goes with every piece and is
   prepared once per worker process (:func:`implicitvox.parallel.jobs.run_piece`).
@@ -37,6 +39,7 @@ from __future__ import annotations
 
 import multiprocessing
 import os
+import pickle
 import threading
 from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 from concurrent.futures.process import BrokenProcessPool
@@ -44,7 +47,11 @@ from typing import Any, Callable, Iterator, Optional, Sequence
 
 from .jobs import Job, run_piece, run_stored_piece, store_job
 
-__all__ = ["farm", "WorkerError", "pool_context", "shutdown_pools"]
+__all__ = ["farm", "WorkerError", "pool_context", "shutdown_pools", "SCATTER_BYTES"]
+
+#: a job pickled larger than this is scattered to Dask's workers once; a smaller one
+#: travels with each task (Dask warns of task graphs past 10 MB: 16 pieces stay far below)
+SCATTER_BYTES = 1 << 18
 
 
 class WorkerError(RuntimeError):
@@ -250,11 +257,13 @@ class _Futures(_Executor):
 
 
 class _Dask:
-    """A ``dask.distributed.Client``: the job scattered to every worker once."""
+    """A ``dask.distributed.Client``: the job scattered to every worker once, or
+    sent with each task when it is small (:data:`SCATTER_BYTES`)."""
 
     def __init__(self, job: Job, client: Any):
         self.client = client
-        self.shared = client.scatter(job, broadcast=True, hash=False)
+        small = len(pickle.dumps(job, protocol=pickle.HIGHEST_PROTOCOL)) <= SCATTER_BYTES
+        self.shared = job if small else client.scatter(job, broadcast=True, hash=False)
         self.futures = []
 
     def submit(self, piece):
@@ -275,12 +284,13 @@ class _Dask:
             raise _died(done, count, what, err) from None
 
     def finish(self) -> None:
-        self.client.cancel([self.shared])       # the job leaves the workers' memory
+        if not isinstance(self.shared, Job):    # the job leaves the workers' memory
+            self.client.cancel([self.shared])
 
     def close(self) -> None:
         if self.futures:
             self.client.cancel(self.futures)
-        self.client.cancel([self.shared])
+        self.finish()
 
 
 def _as_completed(pending: dict) -> Iterator:

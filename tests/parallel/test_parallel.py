@@ -135,11 +135,16 @@ def test_dask_local_cluster_gives_the_serial_voxels():
     with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
                                   dashboard_address=None) as cluster, \
             distributed.Client(cluster) as client:
+        scattered = []                  # a small job goes with its tasks, a big one is scattered
+        scatter = client.scatter
+        client.scatter = lambda *args, **kwargs: scattered.append(1) or scatter(*args, **kwargs)
         vox = iv.voxelize(shape, 48, interior=True, normals=True, executor=client)
         assert vox.metadata["workers"] == 2
         assert digest(vox) == digest(serial)
+        assert not scattered
         mesh_vox = iv.voxelize_mesh(MESH, 48, executor=client)
         assert np.array_equal(mesh_vox.coords(), mesh_serial.coords())
+        assert scattered
 
 
 def test_too_shallow_to_split_runs_serially():
