@@ -19,6 +19,7 @@ from .primitives import (Box, ConvexPolyhedron, Cylinder, Ellipsoid, HalfSpace, 
                          Sphere, Torus)
 from .planar import Circle, Polygon, Rectangle, linear_extrude, rotate_extrude
 from .blends import Blobby, smooth_difference, smooth_intersection, smooth_union
+from .polytopes import NotAPolytope, hull, minkowski
 from .openscad import read_openscad
 from .openscad_parser import OpenSCADError, OpenSCADWarning
 from .scene import SceneError, load_json
@@ -30,5 +31,6 @@ __all__ = [
     "Polyhedron",
     "Circle", "Rectangle", "Polygon", "linear_extrude", "rotate_extrude",
     "smooth_union", "smooth_intersection", "smooth_difference", "Blobby",
+    "hull", "minkowski", "NotAPolytope",
     "read_openscad", "OpenSCADError", "OpenSCADWarning", "load_json", "SceneError",
 ]

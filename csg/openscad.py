@@ -2,12 +2,18 @@
 
 Supported modules: ``group, union, difference, intersection, multmatrix,
 cube, sphere, cylinder, polyhedron, circle, square, polygon, linear_extrude,
-rotate_extrude, color, render, import`` (triangle meshes: STL, PLY, OBJ, VTK)
-with ``$fn, $fa, $fs``, and OpenSCAD's
+rotate_extrude, color, render, import`` (triangle meshes: STL, PLY, OBJ, VTK),
+``hull``, ``minkowski`` and ``resize`` (exact on polytopes,
+:mod:`csg.polytopes`: the operands must be unions of boxes, polyhedra,
+polygons, faceted primitives and straight extrusions; with
+``facets="true"`` their curved children are taken as OpenSCAD's facets, with
+a warning, since the hull of curved solids is no polytope and OpenSCAD itself
+builds it on its facets; ``resize`` scales by the bounding box of those
+facets, as OpenSCAD does), with ``$fn, $fa, $fs``, and OpenSCAD's
 modifiers as its ``.csg`` export writes them: ``%`` (background) and ``*``
 (disabled) drop their subtree, ``#`` (highlight) keeps it, ``!`` (root) makes
 its subtree the whole design. Any other module
-(``hull``, ``minkowski``, ``offset``, ``text``, ``resize``, ...) is
+(``offset``, ``text``, ``projection``, ``surface``, ...) is
 refused with its name, line and column. Nothing is evaluated.
 
 Degenerate input is skipped, as OpenSCAD skips it, with an
@@ -30,10 +36,10 @@ Examples
 ...                   'sphere($fn = 0, $fa = 12, $fs = 2, r = 1.2); }')
 >>> s.bounds
 ((-1.0, -1.0, -1.0), (1.0, 1.0, 1.0))
->>> read_openscad('hull() { cube(size = 1); }')  # doctest: +ELLIPSIS
+>>> read_openscad('offset(r = 1) { square(size = 1); }')  # doctest: +ELLIPSIS
 Traceback (most recent call last):
 ...
-csg.openscad_parser.OpenSCADError: <csg>:1:1: module 'hull' is not supported (supported: ...)
+csg.openscad_parser.OpenSCADError: <csg>:1:1: module 'offset' is not supported (supported: ...)
 """
 from __future__ import annotations
 
@@ -49,7 +55,8 @@ from .openscad_parser import Node, OpenSCADError, OpenSCADWarning, parse
 from .planar import Circle, LinearExtrude, Polygon, Rectangle, RotateExtrude
 from implicitvox.triangles.inputs import MESH_SUFFIXES
 
-from .primitives import Box, ConvexPolyhedron, Cylinder, Polyhedron, Sphere
+from .polytopes import NotAPolytope, convex_solid, hull, minkowski, vertices
+from .primitives import Box, Cylinder, Polyhedron, Sphere
 from .solid import Difference, Intersection, Solid, Transformed, Union
 
 __all__ = ["read_openscad", "SUPPORTED", "UNSUPPORTED", "MAX_SLICES", "IMPORT_SUFFIXES"]
@@ -60,10 +67,10 @@ MAX_SLICES = 10_000
 
 SUPPORTED = ("group", "union", "difference", "intersection", "multmatrix", "cube", "sphere",
              "cylinder", "polyhedron", "circle", "square", "polygon", "linear_extrude",
-             "rotate_extrude", "color", "render", "import")
+             "rotate_extrude", "color", "render", "import", "hull", "minkowski", "resize")
 #: OpenSCAD modules we know but do not voxelize
-UNSUPPORTED = ("hull", "minkowski", "offset", "text", "resize", "surface",
-               "projection", "roof", "mirror", "rotate", "translate", "scale")
+UNSUPPORTED = ("offset", "text", "surface", "projection", "roof", "mirror", "rotate",
+               "translate", "scale")
 #: how far (a share of the height) the prism of a hole runs past the caps of the twisted
 #: or scaled extrusion it is cut from (:func:`csg.facets.extrusion_mesh`)
 HOLE_EXTEND = 1.0
@@ -135,29 +142,6 @@ def _root_node(nodes: list[Node]) -> Optional[Node]:
             return node
         stack.extend(reversed(node.children))
     return None
-
-
-#: convex hulls with more faces become polyhedra (exact test, grid-indexed) instead of a
-#: max over planes, whose cost grows with the number of planes
-MAX_PLANES = 64
-
-
-def _convex(points: np.ndarray) -> Solid:
-    from scipy.spatial import ConvexHull, QhullError
-    try:
-        hull = ConvexHull(points)
-    except QhullError as err:
-        raise ValueError(f"the facets span no volume (flat or degenerate): "
-                         f"{str(err).splitlines()[0]}") from None
-    if len(hull.equations) <= MAX_PLANES:
-        return ConvexPolyhedron(points=points)
-    faces = hull.simplices.copy()
-    # orient every triangle outward: its normal along the hull's facet normal
-    v = points[faces]
-    n = np.cross(v[:, 1] - v[:, 0], v[:, 2] - v[:, 0])
-    flip = np.einsum("ij,ij->i", n, hull.equations[:, :3]) < 0
-    faces[flip] = faces[flip][:, ::-1]
-    return Polyhedron(points, faces)
 
 
 class _Builder:
@@ -298,7 +282,7 @@ class _Builder:
         if not self.faceted:
             return Sphere(r)
         n = fx.fragments(r, *self.resolution(node))
-        return _convex(fx.sphere_points(r, n))
+        return convex_solid(fx.sphere_points(r, n))
 
     def _radius(self, node: Node, rname: str, dname: str, default: float,
                 empty_ok: bool = False) -> float:
@@ -324,7 +308,7 @@ class _Builder:
             return Cylinder(h=h, r1=r1, r2=r2, center=center)
         z1, z2 = (-h / 2, h / 2) if center else (0.0, h)
         n = fx.fragments(max(r1, r2), *self.resolution(node))
-        return _convex(fx.cylinder_points(r1, r2, z1, z2, n))
+        return convex_solid(fx.cylinder_points(r1, r2, z1, z2, n))
 
     def _polyhedron(self, node: Node) -> Optional[Solid]:
         pts = self.arg(node, "points", None, 0)
@@ -500,3 +484,71 @@ class _Builder:
         max_x = max(abs(b[0][0]), abs(b[1][0])) if b is not None else 1.0
         n = max(int(fx.fragments(max_x, *self.resolution(node)) * abs(angle) / 360), 1)
         return RotateExtrude(body, angle, sectors=n)
+
+    # -- hull, minkowski, resize: exact on polytopes (csg.polytopes) ----------------------
+    def _polytope_children(self, node: Node, what: str) -> list[Solid]:
+        """The children as polytope trees of one dimension (children of the other
+        dimension skipped with a warning, as OpenSCAD ignores them). In
+        ``facets="true"``, curved children are taken as OpenSCAD's facets (with a
+        warning): the hull or sum of curved solids is no polytope, and this is the
+        solid OpenSCAD itself makes."""
+        kids = self.children(node)
+        try:
+            for kid in kids:
+                vertices(kid)
+        except NotAPolytope as err:
+            if self.faceted or not err.curved:
+                raise
+            warnings.warn(f"{self.source}:{node.line}:{node.column}: {what}: its curved "
+                          "children are taken as OpenSCAD's facets ($fn, $fa, $fs), as "
+                          "OpenSCAD does", OpenSCADWarning, stacklevel=5)
+            kids = _Builder(self.source, True, self.base).children(node)
+        if kids and any(k.dim != kids[0].dim for k in kids):
+            for child, kid in zip(node.children, kids):
+                if kid.dim != kids[0].dim:
+                    self.skip(child, f"a {kid.dim}D child of a {kids[0].dim}D {what}")
+            kids = [k for k in kids if k.dim == kids[0].dim]
+        return kids
+
+    def _hull(self, node: Node) -> Optional[Solid]:
+        kids = self._polytope_children(node, "hull")
+        return hull(*kids) if kids else None
+
+    def _minkowski(self, node: Node) -> Optional[Solid]:
+        kids = self._polytope_children(node, "minkowski")
+        if len(kids) == 1:
+            return kids[0]
+        return minkowski(*kids) if kids else None
+
+    def _resize(self, node: Node) -> Optional[Solid]:
+        """OpenSCAD's ``resize``: a scale about the origin taking the bounding box
+        of the children's facets to ``newsize`` on every axis where it is not 0;
+        ``auto`` axes (given 0) take the largest of those factors."""
+        body = self._group(node)
+        if body is None:
+            return None
+        dim = body.dim
+        newsize = self.vector(node, "newsize", 3, 0.0, 0)
+        auto = self.vector(node, "auto", 3, 0.0, 1) != 0
+        faceted = body if self.faceted else _Builder(self.source, True, self.base)._group(node)
+        try:
+            points = vertices(faceted)
+        except NotAPolytope as err:
+            raise self.error(node, f"resize: the bounding box of its children is not known "
+                                   f"exactly here: {err}") from None
+        size = np.zeros(3)
+        size[:dim] = points.max(axis=0) - points.min(axis=0)
+        scale = np.ones(3)
+        for axis in range(dim):
+            if newsize[axis] > 0:
+                if size[axis] == 0:
+                    raise self.error(node, "resize: a flat child cannot be resized across "
+                                           "its plane")
+                scale[axis] = newsize[axis] / size[axis]
+        automatic = scale[:dim].max()
+        for axis in range(dim):
+            if auto[axis] and newsize[axis] <= 0:
+                scale[axis] = automatic
+        if np.all(scale == 1):
+            return body
+        return Transformed(body, np.diag([*scale, 1.0]))

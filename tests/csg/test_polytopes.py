@@ -1,0 +1,154 @@
+"""Hulls, Minkowski sums and resize (csg.polytopes, OpenSCAD's hull/minkowski/resize):
+exact on polytopes, checked against independent constructions."""
+from __future__ import annotations
+
+import warnings
+
+import numpy as np
+import pytest
+from scipy.spatial import Delaunay
+
+import csg
+from csg import (Box, Circle, Cylinder, NotAPolytope, Polygon, Polyhedron, Rectangle, Sphere,
+                 hull, linear_extrude, minkowski, read_openscad)
+from csg.polytopes import MAX_PIECES, convex_pieces, vertices
+
+
+def _voxels(solid, bounds, res=40):
+    return solid.voxelize(bounds=bounds, resolution=res, interior=True)
+
+
+def _in_interior(vox, idx):
+    """Whether each voxel index lies in one of the voxelization's interior octants."""
+    out = np.zeros(len(idx), dtype=bool)
+    depth = vox.grid.depth
+    for level, octants in vox.interior.items():
+        keys = {tuple(o) for o in np.asarray(octants)}
+        out |= np.array([tuple(i >> (depth - level)) in keys for i in idx])
+    return out
+
+
+def _tetra(rng):
+    v = rng.uniform(-2, 2, (4, 3))
+    if np.linalg.det(v[1:] - v[0]) < 0:
+        v[[1, 2]] = v[[2, 1]]
+    return v, np.array([[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]])
+
+
+def test_hull_is_the_hull_of_the_vertices():
+    """Points inside the hull of the operands' vertices (scipy's Delaunay, an
+    independent oracle) lie in the hull's voxels or interior octants; points
+    outside it by more than a voxel's diagonal do not."""
+    rng = np.random.default_rng(1)
+    parts = [Box(rng.uniform(0.5, 2, 3)).translate(rng.uniform(-3, 3, 3)) for _ in range(4)]
+    parts.append(Polyhedron(*_tetra(rng)))
+    oracle = Delaunay(np.concatenate([vertices(p) for p in parts]))
+    vox = _voxels(hull(*parts), ((-5, -5, -5), (6, 6, 6)))
+    g = rng.uniform(-5, 6, (4000, 3))
+    idx = vox.grid.voxels_holding(g)[0]
+    held = vox.contains(idx) | _in_interior(vox, idx)
+    assert held[oracle.find_simplex(g) >= 0].all()
+    diagonal = float(np.linalg.norm(vox.voxel_size))
+    assert not held[_far_out(oracle, g, diagonal)].any()
+
+
+def _far_out(oracle, points, distance):
+    """Points farther than ``distance`` outside the hull (its facet planes)."""
+    from scipy.spatial import ConvexHull
+    h = ConvexHull(oracle.points)
+    return (points @ h.equations[:, :3].T + h.equations[:, 3]).max(axis=1) > distance
+
+
+def test_minkowski_of_boxes_is_a_box():
+    a = Box((2, 1, 3)).translate((1, 2, 3))
+    b = Box((1, 4, 1), center=True)
+    s = minkowski(a, b)
+    assert np.allclose(np.array(s.bounds), [(0.5, 0, 2.5), (3.5, 5, 6.5)])
+    box = Box((3, 5, 4)).translate((0.5, 0, 2.5))
+    bounds = ((0, -1, 2), (4, 6, 7))
+    assert np.array_equal(_voxels(s, bounds).coords(), _voxels(box, bounds).coords())
+
+
+def test_minkowski_distributes_over_unions():
+    """An L of two boxes plus a box: the union of the two sums, each a box."""
+    ell = Box((6, 2, 2)) | Box((2, 6, 2)).translate((0, 4, 0))
+    assert len(convex_pieces(ell)) == 2
+    s = minkowski(ell, Box((1, 1, 1), center=True))
+    expected = Box((7, 3, 3)).translate((-0.5, -0.5, -0.5)) | \
+        Box((3, 7, 3)).translate((-0.5, 3.5, -0.5))
+    bounds = ((-1, -1, -1), (7, 11, 3))
+    assert np.array_equal(_voxels(s, bounds).coords(), _voxels(expected, bounds).coords())
+
+
+def test_2d_hull_and_sum():
+    h = hull(Rectangle((1, 1)), Rectangle((1, 1)).translate((3, 2, 0)))
+    assert h.dim == 2 and isinstance(h, Polygon) and len(h.points) == 6
+    m = minkowski(Rectangle((2, 2)), Rectangle((1, 1), center=True))
+    assert np.allclose(np.array(m.bounds)[:, :2], [(-0.5, -0.5), (2.5, 2.5)])
+    prism = linear_extrude(m, 1)
+    assert prism.bounds[1][2] == 1
+
+
+def test_what_is_no_polytope_is_refused_saying_why():
+    with pytest.raises(NotAPolytope, match="Sphere is curved") as err:
+        hull(Sphere(1), Box((1, 1, 1)))
+    assert err.value.curved
+    with pytest.raises(NotAPolytope, match="difference's vertices") as err:
+        hull(Box((2, 2, 2)) - Box((1, 1, 1)))
+    assert not err.value.curved
+    with pytest.raises(NotAPolytope, match="Cylinder is curved"):
+        minkowski(Box((1, 1, 1)), Cylinder(h=1, r=1))
+    with pytest.raises(NotAPolytope, match="non-convex polygon"):
+        minkowski(Polygon([[0, 0], [4, 0], [4, 4], [2, 1], [0, 4]]), Rectangle((1, 1)))
+    with pytest.raises(NotAPolytope, match="Circle is curved"):
+        hull(Circle(1))
+    with pytest.raises(ValueError, match="2D and 3D"):
+        hull(Box((1, 1, 1)), Rectangle((1, 1)))
+    with pytest.raises(ValueError, match="span no volume"):
+        hull(Polyhedron(np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0.0]]), np.array([[0, 1, 2]])))
+
+
+def test_minkowski_pieces_are_bounded():
+    many = csg.Union(*[Box((1, 1, 1)).translate((2 * i, 0, 0)) for i in range(101)])
+    with pytest.raises(ValueError, match="MAX_PIECES"):
+        minkowski(many, many)
+    assert 101 * 101 > MAX_PIECES
+
+
+def test_non_convex_polyhedron_in_a_sum_is_refused():
+    # an L-shaped prism as a closed mesh (from the extrusion of an L polygon)
+    ell = Polygon([[0, 0], [3, 0], [3, 1], [1, 1], [1, 3], [0, 3]])
+    import pyvista as pv
+    mesh = pv.PolyData(np.column_stack([ell.points, np.zeros(6)]),
+                       np.hstack([[6], np.arange(6)])).extrude((0, 0, 1), capping=True)
+    mesh = mesh.triangulate().clean()
+    poly = Polyhedron(mesh)
+    with pytest.raises(NotAPolytope, match="non-convex Polyhedron"):
+        minkowski(poly, Box((1, 1, 1)))
+    assert hull(poly, Box((1, 1, 1))).bounds[1][0] == pytest.approx(3.0)
+
+
+def test_resize_scales_by_the_facets_bounding_box():
+    """OpenSCAD's resize of a sphere: the factor comes from its facets' box (a 12-gon
+    sphere is narrower than 2r), in both modes; auto axes take the largest factor."""
+    text = "resize(newsize = [10, 0, 0], auto = [0, 1, 0]) " \
+           "{ sphere($fn = 12, $fa = 12, $fs = 2, r = 2); }"
+    facets = read_openscad("sphere($fn = 12, $fa = 12, $fs = 2, r = 2);", facets="openscad")
+    lo, hi = np.array(facets.bounds)
+    width = hi - lo
+    assert width[0] < 4
+    lo, hi = np.array(read_openscad(text, facets="openscad").bounds)
+    assert np.allclose(hi - lo, [10, width[1] * 10 / width[0], width[2]])
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")                # no curved hull here: no warning
+        lo, hi = np.array(read_openscad(text).bounds)
+    factor = 10 / width[0]
+    assert np.allclose(hi - lo, [4 * factor, 4 * factor, 4])
+
+
+def test_resize_of_a_difference_is_refused_saying_why():
+    text = "resize(newsize = [5, 5, 5]) { difference() { cube(size = 3); " \
+           "sphere(r = 2, $fn = 8); } }"
+    with pytest.raises(csg.OpenSCADError, match="resize: the bounding box.*difference") as err:
+        read_openscad(text, facets="openscad")
+    assert (err.value.line, err.value.column) == (1, 1)
