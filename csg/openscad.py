@@ -2,7 +2,8 @@
 
 Supported modules: ``group, union, difference, intersection, multmatrix,
 cube, sphere, cylinder, polyhedron, circle, square, polygon, linear_extrude,
-rotate_extrude, color, render, import`` (triangle meshes: STL, PLY, OBJ, VTK),
+rotate_extrude, color, render, import`` (triangle meshes: STL, PLY, OBJ, VTK;
+DXF drawings as OpenSCAD reads them),
 ``hull``, ``minkowski`` and ``resize`` (exact on polytopes,
 :mod:`csg.polytopes`: the operands must be unions of boxes, polyhedra,
 polygons, faceted primitives and straight extrusions; with
@@ -51,6 +52,7 @@ from typing import Any, Optional
 import numpy as np
 
 from . import facets as fx
+from .dxf import read_dxf
 from .openscad_parser import Node, OpenSCADError, OpenSCADWarning, parse
 from .planar import Circle, LinearExtrude, Polygon, Rectangle, RotateExtrude
 from implicitvox.triangles.inputs import MESH_SUFFIXES
@@ -75,7 +77,8 @@ UNSUPPORTED = ("offset", "text", "surface", "projection", "roof", "mirror", "rot
 #: or scaled extrusion it is cut from (:func:`csg.facets.extrusion_mesh`)
 HOLE_EXTEND = 1.0
 #: the files ``import`` reads: triangle meshes (:func:`implicitvox.triangles.inputs.as_triangles`)
-IMPORT_SUFFIXES = MESH_SUFFIXES
+#: and DXF drawings (:func:`csg.dxf.read_dxf`)
+IMPORT_SUFFIXES = (*MESH_SUFFIXES, ".dxf")
 
 
 def read_openscad(path_or_text: Any, facets: str = "true", base: Any = None) -> Solid:
@@ -340,8 +343,10 @@ class _Builder:
 
     def _import(self, node: Node) -> Optional[Solid]:
         """A triangle mesh file, as OpenSCAD imports it: the same solid in both facet
-        modes (a closed mesh, classified exactly); a missing file is skipped with a
-        warning, as OpenSCAD skips it."""
+        modes (a closed mesh, classified exactly); or a DXF drawing's region, as
+        OpenSCAD 2021.01 makes it (:func:`csg.dxf.read_dxf`: ``layer``, ``origin``,
+        ``scale``, arcs in OpenSCAD's fragments in both modes). A missing file is
+        skipped with a warning, as OpenSCAD skips it."""
         name = self.arg(node, "file", None, 0)
         if not isinstance(name, str) or not name:
             raise self.error(node, f"import: file must be a file name, got {name!r:.60}")
@@ -349,10 +354,21 @@ class _Builder:
         suffix = os.path.splitext(name)[1].lower()
         if suffix not in IMPORT_SUFFIXES:
             raise self.error(node, f"import: {suffix or 'this'} files are not read (meshes: "
-                                   f"{', '.join(IMPORT_SUFFIXES)})")
+                                   f"{', '.join(MESH_SUFFIXES)}; drawings: .dxf)")
         if not os.path.isfile(path):
             return self.skip(node, f"cannot open {path!r}")
-        return Polyhedron(path)
+        if suffix != ".dxf":
+            return Polyhedron(path)
+        layer = self.arg(node, "layer", None)
+        if layer is not None and not isinstance(layer, str):
+            raise self.error(node, f"import: layer must be a string, got {layer!r:.60}")
+        fn, fs, fa = self.resolution(node)
+        region = read_dxf(path, layer=layer, origin=self.vector(node, "origin", 2, 0.0),
+                          scale=self.number(node, "scale", 1.0), fn=fn, fs=fs, fa=fa)
+        if region is None:
+            return self.skip(node, f"{path!r}{f' layer {layer!r}' if layer else ''} holds no "
+                                   "closed outline")
+        return region
 
     def _circle(self, node: Node) -> Solid:
         r = self._radius(node, "r", "d", 1.0)

@@ -104,11 +104,119 @@ def _convex(poly: np.ndarray) -> bool:
     return bool(np.all(d1[:, 0] * d2[:, 1] - d1[:, 1] * d2[:, 0] >= 0))
 
 
-def _max_of_edges(poly: np.ndarray, order) -> Expr:
-    """``max`` over the edges of a convex counter-clockwise polygon of the distance outward."""
+#: nesting of pockets in pockets at most for :func:`_hull_tree` (a spiral nests deeper;
+#: it then takes the triangulation with seams)
+MAX_POCKET_DEPTH = 64
+
+
+def _hull_tree(poly: np.ndarray, lid: bool = False, depth: int = 0) -> Optional[Expr]:
+    """The function of a simple counter-clockwise polygon from its convex hull and
+    its pockets, each pocket from its own hull and pockets (Tor and
+    Middleditch's convex difference tree): ``max(hull, -pocket, ...)``.
+
+    The lines are the polygon's own edges and the lids (hull edges closing a
+    pocket). A pocket's function omits its lid (``lid=True``: the closing edge
+    from the last point to the first): the parent's hull holds that side
+    already, and the pocket, open across its lid, is then positive on it, so
+    ``max(hull, -pocket)`` is positive on the lid, where the hull alone is 0.
+    The function is therefore zero only on the polygon's outline, negative
+    inside and positive outside, and, having no inner seams, its interval
+    extension proves boxes inside or outside away from the outline (a
+    triangulation's ``min`` over triangles is 0 along every inner edge).
+    None when pockets nest deeper than :data:`MAX_POCKET_DEPTH`.
+    """
+    from scipy.spatial import ConvexHull, QhullError
+    if depth > MAX_POCKET_DEPTH:
+        return None
+    n = len(poly)
+    try:
+        corners = sorted(ConvexHull(poly).vertices.tolist())      # in the outline's order
+    except QhullError:
+        return None
+    terms = []
+    pockets = []
+    for k, i in enumerate(corners):
+        j = corners[(k + 1) % len(corners)]
+        if lid and i == n - 1 and j == 0:
+            continue                              # the lid this pocket is open across
+        terms.append(_edge(poly[i], poly[j]))
+        chain = np.arange(i, j + 1) if j > i else np.r_[np.arange(i, n), np.arange(0, j + 1)]
+        if len(chain) > 2:
+            pocket = poly[chain[::-1]]            # outside the polygon: counter-clockwise
+            if _area(pocket) > 0:
+                pockets.append(pocket)
+    for pocket in pockets:
+        inner = _max_of_edges(pocket, range(len(pocket)), closed=False) \
+            if _convex(pocket) else _hull_tree(pocket, lid=True, depth=depth + 1)
+        if inner is None:
+            return None
+        terms.append(-inner)
+    return iv.max(*terms) if len(terms) > 1 else terms[0]
+
+
+def _edge(p: np.ndarray, q: np.ndarray) -> Expr:
+    """The distance outward of the line from ``p`` to ``q`` (the inside on its left)."""
+    n = np.array([q[1] - p[1], p[0] - q[0]])
+    n /= np.linalg.norm(n)
+    return n[0] * (x - p[0]) + n[1] * (y - p[1])
+
+
+def _area(poly: np.ndarray) -> float:
+    return 0.5 * float(np.sum(poly[:, 0] * np.roll(poly[:, 1], -1)
+                              - np.roll(poly[:, 0], -1) * poly[:, 1]))
+
+
+def _seams(poly: np.ndarray, triangles: list) -> list[np.ndarray]:
+    """A convex quadrilateral over each inner edge of a triangulation, inside the
+    polygon, holding the edge's open segment in its interior.
+
+    The minimum of the triangles' functions alone is 0 all along an inner edge
+    (both triangles' functions vanish there): the polygon's function would be
+    zero inside it, and every voxel on the edge would look like surface. An
+    inner edge AB between triangles ABC and ABD gets the quadrilateral
+    A C B M, with M on the line from C through AB's midpoint, halfway between
+    AB and the far side of ABD: its diagonals AB and CM cross, so it is convex,
+    its half ABC is the first triangle and its half ABM lies in the second, so
+    it lies in the polygon, and the edge's open segment is inside it. With
+    these pieces the minimum is negative everywhere inside the polygon and zero
+    only on its outline (a triangulation without added points has no inner
+    vertex), and a box across an inner edge is proved inside by one piece.
+    """
+    opposite: dict[tuple[int, int], list[int]] = {}
+    for tri in triangles:
+        for k in range(3):
+            a, b, c = tri[k], tri[(k + 1) % 3], tri[(k + 2) % 3]
+            opposite.setdefault((min(a, b), max(a, b)), []).append(c)
+    quads = []
+    for (a, b), apexes in opposite.items():
+        if len(apexes) != 2:
+            continue                              # an outline edge
+        c, d = apexes
+        mid = (poly[a] + poly[b]) / 2
+        direction = mid - poly[c]
+        reach = np.inf                            # how far along it the triangle ABD goes
+        for p, q, other in ((poly[a], poly[d], poly[b]), (poly[d], poly[b], poly[a])):
+            normal = np.array([q[1] - p[1], p[0] - q[0]])
+            if np.dot(normal, other - p) > 0:
+                normal = -normal                  # pointing away from the triangle
+            speed = float(np.dot(normal, direction))
+            if speed > 0:
+                reach = min(reach, float(np.dot(normal, p - mid)) / speed)
+        if not np.isfinite(reach) or reach <= 0:
+            continue
+        quad = np.array([poly[a], poly[c], poly[b], mid + 0.5 * reach * direction])
+        area = np.sum(quad[:, 0] * np.roll(quad[:, 1], -1) - np.roll(quad[:, 0], -1) * quad[:, 1])
+        quads.append(quad if area > 0 else quad[::-1])
+    return quads
+
+
+def _max_of_edges(poly: np.ndarray, order, closed: bool = True) -> Expr:
+    """``max`` over the edges of a convex counter-clockwise polygon of the distance
+    outward (without the closing edge, from the last point to the first, unless
+    ``closed``)."""
     idx = list(order)
     edges = []
-    for k in range(len(idx)):
+    for k in range(len(idx) if closed else len(idx) - 1):
         p, q = poly[idx[k]], poly[idx[(k + 1) % len(idx)]]
         n = np.array([q[1] - p[1], p[0] - q[0]])
         length = np.linalg.norm(n)
@@ -185,14 +293,12 @@ class Polygon(Shape2D):
             poly = poly[::-1]
         if _convex(poly):                     # one piece: no inner edges to loosen intervals
             return _max_of_edges(poly, range(len(poly)))
-        pieces = []
-        for a, b, c in triangulate(poly):
-            edges = []
-            for p, q in ((poly[a], poly[b]), (poly[b], poly[c]), (poly[c], poly[a])):
-                n = np.array([q[1] - p[1], p[0] - q[0]])
-                n /= np.linalg.norm(n)
-                edges.append(n[0] * (x - p[0]) + n[1] * (y - p[1]))
-            pieces.append(iv.max(*edges))
+        tree = _hull_tree(poly)
+        if tree is not None:
+            return tree
+        triangles = triangulate(poly)
+        pieces = [_max_of_edges(poly, t) for t in triangles]
+        pieces += [_max_of_edges(quad, range(4)) for quad in _seams(poly, triangles)]
         return iv.min(*pieces) if len(pieces) > 1 else pieces[0]
 
     @property
@@ -318,7 +424,7 @@ class RotateExtrude(Solid):
         else:                                 # OpenSCAD's facets: planar trapezoid sectors
             rho = polygonal_radius(self.sectors, self.angle if abs(self.angle) < 360 else 360.0)
         radial = rho if b is None or b[1][0] > 0 else -rho     # a shape at x <= 0 sweeps too
-        solid = shape.expr.remap(x=radial, y=z)
+        solid = _mirrored(shape).expr.remap(x=radial, y=z)
         if abs(self.angle) >= 360:
             return solid
         return iv.max(solid, self._wedge())
@@ -349,6 +455,47 @@ class RotateExtrude(Solid):
         if self.sectors is not None:
             node["sectors"] = self.sectors
         return node
+
+
+def _mirrored(shape: Solid) -> Solid:
+    """A profile with edges on the axis, joined to its mirror image across it (the
+    same where it is swept: x >= 0 or x <= 0), so that those edges are inside it.
+
+    Swept about the axis, a profile's edge on x = 0 is no surface (the solid is
+    on both sides of it), but the profile's function is 0 there: every voxel on
+    the axis would look like surface. Joined to its mirror image, the edge is
+    inside the profile. Done for a rectangle and for a polygon of one outline
+    whose points on the axis are consecutive; other profiles are returned as
+    they are.
+    """
+    b = shape.bounds
+    if b is None or (b[0][0] != 0 and b[1][0] != 0):
+        return shape
+    if isinstance(shape, Rectangle):
+        width = shape.size[0]
+        lo = np.zeros(2) if not shape.centered else -shape.size / 2
+        size = np.array([2 * width, shape.size[1]])
+        centre = np.array([0.0, lo[1] + shape.size[1] / 2])
+        return Polygon(centre + size / 2 * np.array([[-1, -1], [1, -1], [1, 1], [-1, 1]]))
+    if not isinstance(shape, Polygon) or len(shape.paths) != 1:
+        return shape
+    pts = shape.points[shape.paths[0]]
+    on_axis = pts[:, 0] == 0
+    n = len(pts)
+    if on_axis.sum() < 2 or on_axis.all():
+        return shape
+    # rotate the outline so that it starts just after its run of points on the axis
+    starts = [k for k in range(n) if on_axis[k - 1] and not on_axis[k]]
+    if len(starts) != 1:
+        return shape                          # several runs on the axis: left as it is
+    outline = np.roll(pts, -starts[0], axis=0)
+    run = int(on_axis.sum())
+    if not np.roll(on_axis, -starts[0])[-run:].all():
+        return shape
+    side = outline[:-run]                     # off the axis, from the run's end to its start
+    first, last = outline[-1], outline[-run]  # the run's ends: the axis edge last -> first
+    mirror = side[::-1] * np.array([-1.0, 1.0])
+    return Polygon(np.concatenate([[first], side, [last], mirror]))
 
 
 def linear_extrude(shape: Solid, height: float, twist: float = 0.0, scale: Any = 1.0,

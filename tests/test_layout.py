@@ -52,6 +52,7 @@ CSG_ALL = [
     "ConvexPolyhedron", "Polyhedron", "Circle", "Rectangle", "Polygon", "linear_extrude",
     "rotate_extrude", "smooth_union", "smooth_intersection", "smooth_difference", "Blobby",
     "read_openscad", "OpenSCADError", "OpenSCADWarning", "load_json", "SceneError",
+    "hull", "minkowski", "NotAPolytope",
 ]
 
 

@@ -95,5 +95,8 @@ def test_import_of_a_missing_or_unread_file(tmp_path):
         solid = csg.read_openscad('union() {\n  import(file = "gone.stl");\n  cube(size = 1);\n}',
                                   base=tmp_path)
     assert solid.bounds == ((0.0, 0.0, 0.0), (1.0, 1.0, 1.0))
-    with pytest.raises(csg.OpenSCADError, match=r"import: \.dxf files are not read"):
-        csg.read_openscad('import(file = "part.dxf");', base=tmp_path)
+    with pytest.raises(csg.OpenSCADError, match=r"import: \.svg files are not read"):
+        csg.read_openscad('import(file = "part.svg");', base=tmp_path)
+    with pytest.warns(csg.OpenSCADWarning, match=r"<csg>:1:19: import: cannot open .*gone.dxf"):
+        assert csg.read_openscad('linear_extrude(1) import(file = "gone.dxf"); cube(1);',
+                                 base=tmp_path).bounds == ((0.0, 0.0, 0.0), (1.0, 1.0, 1.0))
