@@ -10,11 +10,12 @@ polygons, faceted primitives and straight extrusions; with
 ``facets="true"`` their curved children are taken as OpenSCAD's facets, with
 a warning, since the hull of curved solids is no polytope and OpenSCAD itself
 builds it on its facets; ``resize`` scales by the bounding box of those
-facets, as OpenSCAD does), with ``$fn, $fa, $fs``, and OpenSCAD's
+facets, as OpenSCAD does), ``surface`` (heightmaps, ``.dat`` or PNG, as
+OpenSCAD's mesh: :mod:`csg.heightmap`), with ``$fn, $fa, $fs``, and OpenSCAD's
 modifiers as its ``.csg`` export writes them: ``%`` (background) and ``*``
 (disabled) drop their subtree, ``#`` (highlight) keeps it, ``!`` (root) makes
 its subtree the whole design. Any other module
-(``offset``, ``text``, ``projection``, ``surface``, ...) is
+(``offset``, ``text``, ``projection``, ...) is
 refused with its name, line and column. Nothing is evaluated.
 
 Degenerate input is skipped, as OpenSCAD skips it, with an
@@ -53,6 +54,7 @@ import numpy as np
 
 from . import facets as fx
 from .dxf import read_dxf
+from .heightmap import heightmap_mesh
 from .openscad_parser import Node, OpenSCADError, OpenSCADWarning, parse
 from .planar import Circle, LinearExtrude, Polygon, Rectangle, RotateExtrude
 from implicitvox.triangles.inputs import MESH_SUFFIXES
@@ -69,10 +71,11 @@ MAX_SLICES = 10_000
 
 SUPPORTED = ("group", "union", "difference", "intersection", "multmatrix", "cube", "sphere",
              "cylinder", "polyhedron", "circle", "square", "polygon", "linear_extrude",
-             "rotate_extrude", "color", "render", "import", "hull", "minkowski", "resize")
+             "rotate_extrude", "color", "render", "import", "hull", "minkowski", "resize",
+             "surface")
 #: OpenSCAD modules we know but do not voxelize
-UNSUPPORTED = ("offset", "text", "surface", "projection", "roof", "mirror", "rotate",
-               "translate", "scale")
+UNSUPPORTED = ("offset", "text", "projection", "roof", "mirror", "rotate", "translate",
+               "scale")
 #: how far (a share of the height) the prism of a hole runs past the caps of the twisted
 #: or scaled extrusion it is cut from (:func:`csg.facets.extrusion_mesh`)
 HOLE_EXTEND = 1.0
@@ -369,6 +372,19 @@ class _Builder:
             return self.skip(node, f"{path!r}{f' layer {layer!r}' if layer else ''} holds no "
                                    "closed outline")
         return region
+
+    def _surface(self, node: Node) -> Optional[Solid]:
+        """A heightmap (``.dat`` or PNG) as the closed mesh OpenSCAD 2021.01 builds
+        (:func:`csg.heightmap.heightmap_mesh`), the same in both facet modes; a
+        missing file is skipped with a warning, as OpenSCAD skips it."""
+        name = self.arg(node, "file", None, 0)
+        if not isinstance(name, str) or not name:
+            raise self.error(node, f"surface: file must be a file name, got {name!r:.60}")
+        path = name if os.path.isabs(name) else os.path.join(self.base, name)
+        if not os.path.isfile(path):
+            return self.skip(node, f"cannot open {path!r}")
+        return Polyhedron(*heightmap_mesh(path, center=self.flag(node, "center"),
+                                          invert=self.flag(node, "invert")))
 
     def _circle(self, node: Node) -> Solid:
         r = self._radius(node, "r", "d", 1.0)
