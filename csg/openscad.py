@@ -11,11 +11,13 @@ polygons, faceted primitives and straight extrusions; with
 a warning, since the hull of curved solids is no polytope and OpenSCAD itself
 builds it on its facets; ``resize`` scales by the bounding box of those
 facets, as OpenSCAD does), ``surface`` (heightmaps, ``.dat`` or PNG, as
-OpenSCAD's mesh: :mod:`csg.heightmap`), with ``$fn, $fa, $fs``, and OpenSCAD's
+OpenSCAD's mesh: :mod:`csg.heightmap`), ``offset`` (``r``, ``delta``,
+``chamfer``: with Clipper, as OpenSCAD computes it, :mod:`csg.clipper2d`), with
+``$fn, $fa, $fs``, and OpenSCAD's
 modifiers as its ``.csg`` export writes them: ``%`` (background) and ``*``
 (disabled) drop their subtree, ``#`` (highlight) keeps it, ``!`` (root) makes
 its subtree the whole design. Any other module
-(``offset``, ``text``, ``projection``, ...) is
+(``text``, ``projection``, ...) is
 refused with its name, line and column. Nothing is evaluated.
 
 Degenerate input is skipped, as OpenSCAD skips it, with an
@@ -53,6 +55,7 @@ from typing import Any, Optional
 import numpy as np
 
 from . import facets as fx
+from .clipper2d import NotFlat, offset as clipped_offset
 from .dxf import read_dxf
 from .heightmap import heightmap_mesh
 from .openscad_parser import Node, OpenSCADError, OpenSCADWarning, parse
@@ -72,10 +75,9 @@ MAX_SLICES = 10_000
 SUPPORTED = ("group", "union", "difference", "intersection", "multmatrix", "cube", "sphere",
              "cylinder", "polyhedron", "circle", "square", "polygon", "linear_extrude",
              "rotate_extrude", "color", "render", "import", "hull", "minkowski", "resize",
-             "surface")
+             "surface", "offset")
 #: OpenSCAD modules we know but do not voxelize
-UNSUPPORTED = ("offset", "text", "projection", "roof", "mirror", "rotate", "translate",
-               "scale")
+UNSUPPORTED = ("text", "projection", "roof", "mirror", "rotate", "translate", "scale")
 #: how far (a share of the height) the prism of a hole runs past the caps of the twisted
 #: or scaled extrusion it is cut from (:func:`csg.facets.extrusion_mesh`)
 HOLE_EXTEND = 1.0
@@ -551,6 +553,38 @@ class _Builder:
         if len(kids) == 1:
             return kids[0]
         return minkowski(*kids) if kids else None
+
+    def _offset(self, node: Node) -> Optional[Solid]:
+        """OpenSCAD's 2D ``offset`` (``r``: round joins in OpenSCAD's fragments of a
+        circle of radius ``|r|``; ``delta``: sharp corners, or cut with ``chamfer``),
+        computed with Clipper as OpenSCAD computes it (:func:`csg.clipper2d.offset`).
+        With ``facets="true"`` a true circle below it is taken as OpenSCAD's
+        polygon, with a warning (an offset outline is OpenSCAD's Clipper result)."""
+        body = self._group(node)
+        if body is None:
+            return None
+        if body.dim != 2:
+            return self.skip(node, "a 3D child (offset works on 2D shapes)")
+        if self.arg(node, "r", None) is not None:
+            value, join = self.number(node, "r"), "round"
+        else:
+            value = self.number(node, "delta", 1.0)
+            join = "square" if self.flag(node, "chamfer") else "miter"
+        fn, fs, fa = self.resolution(node)
+        n = fx.fragments(abs(value), fn, fs, fa)
+        try:
+            region = clipped_offset(body, value, join, n)
+        except NotFlat:
+            if self.faceted:
+                raise
+            warnings.warn(f"{self.source}:{node.line}:{node.column}: offset: its circles are "
+                          "taken as OpenSCAD's polygons ($fn, $fa, $fs), as OpenSCAD does",
+                          OpenSCADWarning, stacklevel=5)
+            body = _Builder(self.source, True, self.base)._group(node)
+            region = clipped_offset(body, value, join, n)
+        if region is None:
+            return self.skip(node, f"the offset by {value:g} leaves nothing")
+        return region
 
     def _resize(self, node: Node) -> Optional[Solid]:
         """OpenSCAD's ``resize``: a scale about the origin taking the bounding box

@@ -1,0 +1,150 @@
+"""2D regions as OpenSCAD 2021.01 computes them, with Clipper: booleans and ``offset``.
+
+OpenSCAD evaluates its 2D operations with Angus Johnson's Clipper on integer
+coordinates (``ClipperUtils``: points times 2¹⁶, truncated); here the same
+library does it, through `pyclipper <https://github.com/fonttools/pyclipper>`_,
+on the same integers, so the outlines are OpenSCAD's:
+
+* a leaf's outlines are sanitized with an even-odd union (``polygon`` is
+  filled even-odd), a ``multmatrix`` moves the points before they are scaled;
+* ``union``/``group`` is one non-zero union of the children, ``difference``
+  the first child minus the others, ``intersection`` a chain of binary
+  intersections (``ClipperUtils::apply``);
+* ``offset`` unites its children, then offsets the outlines
+  (``ClipperOffset``): ``r`` with round joins, whose arcs take the tolerance
+  ``|r| (1 − cos(180° / n))`` for OpenSCAD's ``n`` fragments of a circle of
+  radius ``|r|`` (so a full turn has ``n`` steps), ``delta`` with miter joins
+  (a miter limit of 10⁶: corners stay sharp), ``chamfer`` with square joins.
+
+The result is a :class:`~csg.planar.Polygon` of the outlines (filled
+even-odd: Clipper's outlines do not cross), or None when nothing is left.
+
+Examples
+--------
+>>> from csg import Rectangle
+>>> rounded = offset(Rectangle((2, 2), center=True), 1.0, "round", fragments=8)
+>>> len(rounded.points), rounded.bounds
+(12, ((-2.0, -2.0, 0.0), (2.0, 2.0, 0.0)))
+>>> offset(Rectangle((2, 2)), -1.5, "miter") is None        # shrunk away
+True
+"""
+from __future__ import annotations
+
+import math
+from typing import Optional
+
+import numpy as np
+
+from .planar import Circle, Polygon, Rectangle
+from .solid import Difference, Intersection, Solid, Transformed, Union
+
+__all__ = ["region_paths", "offset", "to_polygon", "CLIPPER_SCALE", "MITER_LIMIT", "NotFlat"]
+
+#: OpenSCAD 2021.01's ``ClipperUtils::CLIPPER_SCALE``: points are times this, truncated
+CLIPPER_SCALE = float(1 << 16)
+#: OpenSCAD's ``offset`` miter limit (``delta`` keeps every corner sharp)
+MITER_LIMIT = 1_000_000.0
+_JOINS = {"round": "JT_ROUND", "miter": "JT_MITER", "square": "JT_SQUARE"}
+
+
+class NotFlat(ValueError):
+    """A 2D tree with a leaf that has no outline (a true circle: facet it first)."""
+
+
+def _to_int(points: np.ndarray) -> list:
+    """Points as Clipper's integers: times :data:`CLIPPER_SCALE`, truncated toward zero
+    (C++'s conversion of a double to ``IntPoint``)."""
+    return np.trunc(points * CLIPPER_SCALE).astype(np.int64).tolist()
+
+
+def _clip(subjects: list, clips: list, operation: str, fill: str = "PFT_NONZERO") -> list:
+    import pyclipper
+    clipper = pyclipper.Pyclipper()
+    if subjects:
+        clipper.AddPaths(subjects, pyclipper.PT_SUBJECT, True)
+    if clips:
+        clipper.AddPaths(clips, pyclipper.PT_CLIP, True)
+    fill_type = getattr(pyclipper, fill)
+    return clipper.Execute(getattr(pyclipper, operation), fill_type, fill_type)
+
+
+def _usable(paths: list) -> list:
+    return [p for p in paths if len(p) >= 3]
+
+
+def region_paths(solid: Solid, matrix: Optional[np.ndarray] = None) -> list:
+    """The outlines (Clipper integer paths) of a 2D tree, as OpenSCAD evaluates it.
+
+    Raises
+    ------
+    NotFlat
+        A leaf with no outline (a true :class:`~csg.planar.Circle`).
+    """
+    matrix = np.eye(4) if matrix is None else matrix
+    if isinstance(solid, Transformed):
+        return region_paths(solid.children[0], matrix @ solid.matrix)
+    if isinstance(solid, (Union, Difference, Intersection)):
+        parts = [region_paths(c, matrix) for c in solid.children]
+        if isinstance(solid, Union):
+            return _clip([p for part in parts for p in part], [], "CT_UNION")
+        if isinstance(solid, Difference):
+            return _clip(parts[0], [p for part in parts[1:] for p in part], "CT_DIFFERENCE")
+        out = parts[0]
+        for part in parts[1:]:
+            out = _clip(out, part, "CT_INTERSECTION")
+        return out
+    outlines = _leaf_outlines(solid)
+    moved = [o @ matrix[:2, :2].T + matrix[:2, 3] for o in outlines]
+    paths = _usable([_to_int(o) for o in moved])
+    return _clip(paths, [], "CT_UNION", "PFT_EVENODD")      # OpenSCAD's sanitize
+
+
+def _leaf_outlines(solid: Solid) -> list[np.ndarray]:
+    if isinstance(solid, Rectangle):
+        lo = -solid.size / 2 if solid.centered else np.zeros(2)
+        hi = lo + solid.size
+        return [np.array([[lo[0], lo[1]], [hi[0], lo[1]], [hi[0], hi[1]], [lo[0], hi[1]]])]
+    if isinstance(solid, Polygon):
+        return [solid.points[p] for p in solid.paths]
+    if isinstance(solid, Circle):
+        raise NotFlat("a true circle has no outline (facet it first, as OpenSCAD does: "
+                      "read_openscad(..., facets='openscad'))")
+    raise NotFlat(f"a {type(solid).__name__} is not a 2D shape with outlines")
+
+
+def to_polygon(paths: list) -> Optional[Polygon]:
+    """Clipper's outlines as a :class:`~csg.planar.Polygon` (even-odd), or None."""
+    paths = _usable(paths)
+    if not paths:
+        return None
+    outlines = [np.asarray(p, dtype=np.float64) / CLIPPER_SCALE for p in paths]
+    points = np.concatenate(outlines)
+    starts = np.cumsum([0] + [len(o) for o in outlines])
+    return Polygon(points, [list(range(a, b)) for a, b in zip(starts[:-1], starts[1:])])
+
+
+def offset(solid: Solid, delta: float, join: str = "round", fragments: Optional[int] = None
+           ) -> Optional[Polygon]:
+    """OpenSCAD's ``offset`` of a 2D tree: ``join`` is ``"round"`` (``r``, arcs of
+    ``fragments`` steps per full turn), ``"miter"`` (``delta``) or ``"square"``
+    (``delta`` with ``chamfer``). None when the offset leaves nothing.
+
+    Raises
+    ------
+    NotFlat
+        As :func:`region_paths`.
+    ValueError
+        An unknown ``join``, or a round join without ``fragments``.
+    """
+    import pyclipper
+    if join not in _JOINS:
+        raise ValueError(f"join must be one of {sorted(_JOINS)}, got {join!r}")
+    if join == "round" and not fragments:
+        raise ValueError("a round offset needs fragments (OpenSCAD's n for a circle of |r|)")
+    n = fragments or 3
+    arc_tolerance = abs(delta) * (1 - math.cos(math.radians(180.0 / n)))
+    united = _clip(region_paths(solid), [], "CT_UNION")
+    co = pyclipper.PyclipperOffset(MITER_LIMIT, arc_tolerance * CLIPPER_SCALE)
+    if united:
+        co.AddPaths(united, getattr(pyclipper, _JOINS[join]), pyclipper.ET_CLOSEDPOLYGON)
+    return to_polygon(co.Execute(delta * CLIPPER_SCALE) if united else [])
