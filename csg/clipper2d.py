@@ -38,7 +38,8 @@ import numpy as np
 from .planar import Circle, Polygon, Rectangle
 from .solid import Difference, Intersection, Solid, Transformed, Union
 
-__all__ = ["region_paths", "offset", "to_polygon", "CLIPPER_SCALE", "MITER_LIMIT", "NotFlat"]
+__all__ = ["region_paths", "offset", "to_polygon", "clip", "to_clipper", "CLIPPER_SCALE",
+           "MITER_LIMIT", "NotFlat"]
 
 #: OpenSCAD 2021.01's ``ClipperUtils::CLIPPER_SCALE``: points are times this, truncated
 CLIPPER_SCALE = float(1 << 16)
@@ -51,17 +52,21 @@ class NotFlat(ValueError):
     """A 2D tree with a leaf that has no outline (a true circle: facet it first)."""
 
 
-def _to_int(points: np.ndarray) -> list:
+def to_clipper(points: np.ndarray) -> list:
     """Points as Clipper's integers: times :data:`CLIPPER_SCALE`, truncated toward zero
     (C++'s conversion of a double to ``IntPoint``)."""
     return np.trunc(points * CLIPPER_SCALE).astype(np.int64).tolist()
 
 
-def _clip(subjects: list, clips: list, operation: str, fill: str = "PFT_NONZERO") -> list:
+def clip(subjects: list, clips: list, operation: str, fill: str = "PFT_NONZERO") -> list:
+    """One Clipper operation (``"CT_UNION"``, ``"CT_DIFFERENCE"``, ``"CT_INTERSECTION"``)
+    on integer paths, both sides filled by ``fill`` (``"PFT_NONZERO"`` as OpenSCAD's
+    booleans, ``"PFT_EVENODD"`` as its sanitize)."""
     import pyclipper
+    if not subjects:
+        return []                                 # nothing to unite, cut or keep
     clipper = pyclipper.Pyclipper()
-    if subjects:
-        clipper.AddPaths(subjects, pyclipper.PT_SUBJECT, True)
+    clipper.AddPaths(subjects, pyclipper.PT_SUBJECT, True)
     if clips:
         clipper.AddPaths(clips, pyclipper.PT_CLIP, True)
     fill_type = getattr(pyclipper, fill)
@@ -86,17 +91,17 @@ def region_paths(solid: Solid, matrix: Optional[np.ndarray] = None) -> list:
     if isinstance(solid, (Union, Difference, Intersection)):
         parts = [region_paths(c, matrix) for c in solid.children]
         if isinstance(solid, Union):
-            return _clip([p for part in parts for p in part], [], "CT_UNION")
+            return clip([p for part in parts for p in part], [], "CT_UNION")
         if isinstance(solid, Difference):
-            return _clip(parts[0], [p for part in parts[1:] for p in part], "CT_DIFFERENCE")
+            return clip(parts[0], [p for part in parts[1:] for p in part], "CT_DIFFERENCE")
         out = parts[0]
         for part in parts[1:]:
-            out = _clip(out, part, "CT_INTERSECTION")
+            out = clip(out, part, "CT_INTERSECTION")
         return out
     outlines = _leaf_outlines(solid)
     moved = [o @ matrix[:2, :2].T + matrix[:2, 3] for o in outlines]
-    paths = _usable([_to_int(o) for o in moved])
-    return _clip(paths, [], "CT_UNION", "PFT_EVENODD")      # OpenSCAD's sanitize
+    paths = _usable([to_clipper(o) for o in moved])
+    return clip(paths, [], "CT_UNION", "PFT_EVENODD")      # OpenSCAD's sanitize
 
 
 def _leaf_outlines(solid: Solid) -> list[np.ndarray]:
@@ -143,7 +148,7 @@ def offset(solid: Solid, delta: float, join: str = "round", fragments: Optional[
         raise ValueError("a round offset needs fragments (OpenSCAD's n for a circle of |r|)")
     n = fragments or 3
     arc_tolerance = abs(delta) * (1 - math.cos(math.radians(180.0 / n)))
-    united = _clip(region_paths(solid), [], "CT_UNION")
+    united = clip(region_paths(solid), [], "CT_UNION")
     co = pyclipper.PyclipperOffset(MITER_LIMIT, arc_tolerance * CLIPPER_SCALE)
     if united:
         co.AddPaths(united, getattr(pyclipper, _JOINS[join]), pyclipper.ET_CLOSEDPOLYGON)

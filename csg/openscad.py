@@ -12,12 +12,14 @@ a warning, since the hull of curved solids is no polytope and OpenSCAD itself
 builds it on its facets; ``resize`` scales by the bounding box of those
 facets, as OpenSCAD does), ``surface`` (heightmaps, ``.dat`` or PNG, as
 OpenSCAD's mesh: :mod:`csg.heightmap`), ``offset`` (``r``, ``delta``,
-``chamfer``: with Clipper, as OpenSCAD computes it, :mod:`csg.clipper2d`), with
+``chamfer``: with Clipper, as OpenSCAD computes it, :mod:`csg.clipper2d`),
+``projection`` (the section by z = 0 through any boolean, or the shadow of
+meshes and polytopes: :mod:`csg.projection`), with
 ``$fn, $fa, $fs``, and OpenSCAD's
 modifiers as its ``.csg`` export writes them: ``%`` (background) and ``*``
 (disabled) drop their subtree, ``#`` (highlight) keeps it, ``!`` (root) makes
 its subtree the whole design. Any other module
-(``text``, ``projection``, ...) is
+(``text``, ``roof``, ...) is
 refused with its name, line and column. Nothing is evaluated.
 
 Degenerate input is skipped, as OpenSCAD skips it, with an
@@ -57,6 +59,7 @@ import numpy as np
 from . import facets as fx
 from .clipper2d import NotFlat, offset as clipped_offset
 from .dxf import read_dxf
+from .projection import NotAMesh, projection as project
 from .heightmap import heightmap_mesh
 from .openscad_parser import Node, OpenSCADError, OpenSCADWarning, parse
 from .planar import Circle, LinearExtrude, Polygon, Rectangle, RotateExtrude
@@ -75,9 +78,9 @@ MAX_SLICES = 10_000
 SUPPORTED = ("group", "union", "difference", "intersection", "multmatrix", "cube", "sphere",
              "cylinder", "polyhedron", "circle", "square", "polygon", "linear_extrude",
              "rotate_extrude", "color", "render", "import", "hull", "minkowski", "resize",
-             "surface", "offset")
+             "surface", "offset", "projection")
 #: OpenSCAD modules we know but do not voxelize
-UNSUPPORTED = ("text", "projection", "roof", "mirror", "rotate", "translate", "scale")
+UNSUPPORTED = ("text", "roof", "mirror", "rotate", "translate", "scale")
 #: how far (a share of the height) the prism of a hole runs past the caps of the twisted
 #: or scaled extrusion it is cut from (:func:`csg.facets.extrusion_mesh`)
 HOLE_EXTEND = 1.0
@@ -584,6 +587,31 @@ class _Builder:
             region = clipped_offset(body, value, join, n)
         if region is None:
             return self.skip(node, f"the offset by {value:g} leaves nothing")
+        return region
+
+    def _projection(self, node: Node) -> Optional[Solid]:
+        """OpenSCAD's ``projection``: the section by z = 0 (``cut = true``, exact, through
+        any boolean) or the shadow on z = 0 of meshes and polytopes
+        (:func:`csg.projection.projection`). With ``facets="true"`` curved children
+        are taken as OpenSCAD's facets, with a warning."""
+        body = self._group(node)
+        if body is None:
+            return None
+        if body.dim != 3:
+            return self.skip(node, "a 2D child (projection flattens 3D solids)")
+        cut = self.flag(node, "cut")
+        try:
+            region = project(body, cut=cut)
+        except NotAMesh as err:
+            if self.faceted or not err.curved:
+                raise
+            warnings.warn(f"{self.source}:{node.line}:{node.column}: projection: its curved "
+                          "children are taken as OpenSCAD's facets ($fn, $fa, $fs), as "
+                          "OpenSCAD does", OpenSCADWarning, stacklevel=5)
+            region = project(_Builder(self.source, True, self.base)._group(node), cut=cut)
+        if region is None:
+            return self.skip(node, "the projection is empty" + (" (nothing meets z = 0)"
+                                                                 if cut else ""))
         return region
 
     def _resize(self, node: Node) -> Optional[Solid]:

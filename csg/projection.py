@@ -1,0 +1,171 @@
+"""OpenSCAD's ``projection``: a 3D tree of polytopes and meshes flattened to 2D.
+
+* ``cut=True``: the section by the plane z = 0. A section distributes over
+  every boolean (the section of ``A − B`` is the section of ``A`` minus that of
+  ``B``), so each leaf's triangle mesh is sliced (the crossing point of each
+  mesh edge is computed once, so neighbouring triangles share it exactly, and
+  the segments chain into closed outlines) and the outlines are combined by
+  the tree's booleans with Clipper (:mod:`csg.clipper2d`), as OpenSCAD
+  combines 2D shapes. A vertex on the plane counts as below it: the cut is
+  that of the plane just above z = 0, so a part resting on z = 0 gives its
+  footprint, as in OpenSCAD (whose exact cut also gives the face of a part
+  hanging from z = 0, where this gives nothing).
+* ``cut=False``: the shadow on z = 0, the union of every triangle projected,
+  as OpenSCAD's ``PolysetUtils::project`` and Clipper's non-zero union make it.
+  A shadow distributes over unions only: a difference or intersection below
+  it is refused, saying so.
+
+Leaves: :class:`~csg.primitives.Polyhedron` (imported meshes, ``surface``,
+polyhedra), :class:`~csg.primitives.ConvexPolyhedron` given by points (OpenSCAD's
+faceted spheres and cylinders), :class:`~csg.primitives.Box`, moved by any
+``multmatrix``. A curved leaf raises :class:`NotAMesh` (``curved`` set: the
+reader then takes OpenSCAD's facets, with a warning).
+
+Examples
+--------
+>>> from csg import Box
+>>> section = projection(Box((2, 2, 2), center=True) - Box((1, 1, 4), center=True), cut=True)
+>>> len(section.paths), section.bounds
+(2, ((-1.0, -1.0, 0.0), (1.0, 1.0, 0.0)))
+>>> shadow = projection(Box((1, 1, 1)) | Box((1, 1, 1)).translate((3, 0, 0)), cut=False)
+>>> len(shadow.paths)
+2
+"""
+from __future__ import annotations
+
+from typing import Optional
+
+import numpy as np
+
+from .clipper2d import clip, to_clipper, to_polygon
+from .planar import Polygon
+from .primitives import (Box, ConvexPolyhedron, Cylinder, Ellipsoid, Polyhedron, Sphere,
+                         Torus)
+from .solid import Difference, Intersection, Solid, Transformed, Union
+
+__all__ = ["projection", "leaf_mesh", "section_outlines", "NotAMesh"]
+
+_CURVED = (Sphere, Cylinder, Torus, Ellipsoid)
+
+
+class NotAMesh(ValueError):
+    """A 3D leaf with no triangle mesh (curved), or a shadow of a difference or
+    intersection."""
+
+    def __init__(self, message: str, curved: bool = False):
+        super().__init__(message)
+        #: the reason is a curved leaf (its facets would do)
+        self.curved = curved
+
+
+def leaf_mesh(solid: Solid, matrix: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The closed triangle mesh (vertices, faces) of a polytope leaf, moved by ``matrix``."""
+    from scipy.spatial import ConvexHull
+    if isinstance(solid, _CURVED):
+        raise NotAMesh(f"a {type(solid).__name__} is curved: it has no mesh to project "
+                       "(facet it first: read_openscad(..., facets='openscad'))", curved=True)
+    if isinstance(solid, Polyhedron):
+        v, f = solid.vertices, solid.faces
+    elif isinstance(solid, ConvexPolyhedron) and solid.points is not None:
+        v = solid.points
+        f = ConvexHull(v).simplices
+    elif isinstance(solid, Box):
+        lo = -solid.size / 2 if solid.centered else np.zeros(3)
+        v = lo + np.array([[i, j, k] for i in (0, 1) for j in (0, 1) for k in (0, 1)]) * solid.size
+        f = ConvexHull(v).simplices
+    else:
+        raise NotAMesh(f"a {type(solid).__name__} has no triangle mesh here (projection takes "
+                       "polyhedra, imported meshes, surfaces, boxes and faceted primitives)",
+                       curved=type(solid).__name__ in ("LinearExtrude", "RotateExtrude"))
+    return v @ matrix[:3, :3].T + matrix[:3, 3], np.asarray(f)
+
+
+def section_outlines(vertices: np.ndarray, faces: np.ndarray) -> list[np.ndarray]:
+    """The closed outlines (each (k, 2)) where the plane z = 0 cuts a closed mesh
+    (a vertex on the plane counts as below it: the plane just above z = 0)."""
+    above = vertices[:, 2] > 0
+    edges = np.concatenate([faces[:, [0, 1]], faces[:, [1, 2]], faces[:, [2, 0]]])
+    crossing = above[edges[:, 0]] != above[edges[:, 1]]
+    tri_cross = crossing.reshape(3, -1).T                  # per face: which edges cross
+    cut = tri_cross.sum(axis=1) == 2
+    if not cut.any():
+        return []
+    key = np.sort(edges, axis=1)
+    unique, inverse = np.unique(key[crossing], axis=0, return_inverse=True)
+    a, b = vertices[unique[:, 0]], vertices[unique[:, 1]]
+    t = a[:, 2] / (a[:, 2] - b[:, 2])
+    points = a[:, :2] + t[:, None] * (b[:, :2] - a[:, :2])
+    edge_id = np.full(len(edges), -1)
+    edge_id[np.flatnonzero(crossing)] = inverse.ravel()
+    ids = edge_id.reshape(3, -1).T[cut]                    # (m, 3), two of them >= 0
+    ends = np.sort(ids, axis=1)[:, 1:]                     # each cut face: its two points
+    neighbours: dict[int, list[int]] = {}
+    for p, q in ends.tolist():
+        neighbours.setdefault(p, []).append(q)
+        neighbours.setdefault(q, []).append(p)
+    seen: set[int] = set()
+    loops = []
+    for start in neighbours:
+        if start in seen:
+            continue
+        loop, previous, current = [start], None, start
+        seen.add(start)
+        while True:
+            options = [n for n in neighbours[current] if n != previous] or neighbours[current]
+            nxt = options[0]
+            if nxt == start or nxt in seen:
+                break
+            loop.append(nxt)
+            seen.add(nxt)
+            previous, current = current, nxt
+        if len(loop) >= 3:
+            loops.append(points[loop])
+    return loops
+
+
+def _cut_paths(solid: Solid, matrix: np.ndarray) -> list:
+    if isinstance(solid, Transformed):
+        return _cut_paths(solid.children[0], matrix @ solid.matrix)
+    if isinstance(solid, (Union, Difference, Intersection)):
+        parts = [_cut_paths(c, matrix) for c in solid.children]
+        if isinstance(solid, Union):
+            return clip([p for part in parts for p in part], [], "CT_UNION")
+        if isinstance(solid, Difference):
+            return clip(parts[0], [p for part in parts[1:] for p in part], "CT_DIFFERENCE")
+        out = parts[0]
+        for part in parts[1:]:
+            out = clip(out, part, "CT_INTERSECTION")
+        return out
+    loops = section_outlines(*leaf_mesh(solid, matrix))
+    return clip([to_clipper(loop) for loop in loops], [], "CT_UNION", "PFT_EVENODD")
+
+
+def _shadow_paths(solid: Solid, matrix: np.ndarray) -> list:
+    if isinstance(solid, Transformed):
+        return _shadow_paths(solid.children[0], matrix @ solid.matrix)
+    if isinstance(solid, Union):
+        return clip([p for c in solid.children for p in _shadow_paths(c, matrix)], [],
+                     "CT_UNION")
+    if isinstance(solid, (Difference, Intersection)):
+        raise NotAMesh(f"the shadow of a {type(solid).__name__.lower()} needs the boolean's "
+                       "result, which is not built here (projection(cut = true) is exact)")
+    v, f = leaf_mesh(solid, matrix)
+    tri = v[f][:, :, :2]
+    u, w = tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]
+    area = u[:, 0] * w[:, 1] - u[:, 1] * w[:, 0]
+    tri = tri[area != 0]
+    tri[area[area != 0] < 0] = tri[area[area != 0] < 0][:, ::-1]     # all counter-clockwise
+    return clip([to_clipper(t) for t in tri], [], "CT_UNION")
+
+
+def projection(solid: Solid, cut: bool = False) -> Optional[Polygon]:
+    """OpenSCAD's ``projection`` of a 3D tree: its section by z = 0 (``cut``) or its
+    shadow on z = 0, as a :class:`~csg.planar.Polygon`; None when empty.
+
+    Raises
+    ------
+    NotAMesh
+        A curved leaf, or (``cut=False``) a difference or intersection.
+    """
+    paths = _cut_paths(solid, np.eye(4)) if cut else _shadow_paths(solid, np.eye(4))
+    return to_polygon(paths)
