@@ -244,7 +244,10 @@ class MeshClassifier:
         self.cell_tris, self.cell_start = buckets(key, tri, self.cells ** 3)
 
     def _cell(self, p: np.ndarray) -> np.ndarray:
-        # a cell index per point, widened by one cell below so rounding cannot drop a triangle
+        """The cell of each point: ``floor((p - lo) / size)``, clipped. Every step is
+        monotone in floating point (a rounded subtraction, a rounded division by a
+        positive number, floor, clip), so a box and a triangle whose coordinate
+        ranges overlap get cell ranges that overlap: no slack is needed."""
         c = np.floor((p - self.lo) / self.cell_size).astype(np.int64)
         return np.clip(c, 0, self.cells - 1)
 
@@ -267,10 +270,10 @@ class MeshClassifier:
         return state
 
     def _pairs(self, boxes: np.ndarray, lo: np.ndarray, hi: np.ndarray):
-        """(box, triangle) candidate pairs from the cells each box covers (one cell of
-        slack on each side covers the cell computation's rounding)."""
-        first = np.maximum(self._cell(lo[boxes]) - 1, 0)
-        last = np.minimum(self._cell(hi[boxes]) + 1, self.cells - 1)
+        """(box, triangle) candidate pairs from the cells each box covers (exactly those:
+        :meth:`_cell` is monotone, so a triangle meeting the box shares a cell with it)."""
+        first = self._cell(lo[boxes])
+        last = self._cell(hi[boxes])
         b, cell = expand_boxes(first, last)
         key = (cell[:, 0] * self.cells + cell[:, 1]) * self.cells + cell[:, 2]
         pair, index = gather(self.cell_start[key], self.cell_start[key + 1] - self.cell_start[key])
