@@ -175,7 +175,7 @@ def subdivide_in_parallel(shape: Any, func: Function, grid: Grid, options: dict,
     depth = grid.depth + s                     # levels of the grid subdivided
     exact = (exact_classifier(shape), voxel_classifier(shape))
     pieces_wanted = PIECES_PER_WORKER * workers if estimated is None else \
-        pieces_for(workers, estimated)
+        pieces_for(workers, estimated, executor)
     heads: list[Subdivision] = []
     if start is not None:
         level, pending = start[0], morton.encode(start[1])

@@ -20,9 +20,11 @@ itself (:mod:`implicitvox.octree.subtrees`, :mod:`implicitvox.triangles.pairs`,
 """
 from .farm import SCATTER_BYTES, WorkerError, farm
 from .jobs import Job, run_piece
-from .plan import (MIN_PARALLEL_WORK, PIECES_PER_WORKER, WORK_PER_PIECE, WORKERS_VARIABLE,
-                   available_cores, executor_workers, pieces_for, plan_workers, split_evenly)
+from .plan import (DASK_WORK_PER_PIECE, MIN_PARALLEL_WORK, PIECES_PER_WORKER, WORK_PER_PIECE,
+                   WORKERS_VARIABLE, available_cores, executor_workers, is_dask_client,
+                   pieces_for, plan_workers, split_evenly)
 
 __all__ = ["farm", "WorkerError", "Job", "run_piece", "available_cores", "executor_workers",
            "plan_workers", "pieces_for", "split_evenly", "MIN_PARALLEL_WORK", "PIECES_PER_WORKER",
-           "WORK_PER_PIECE", "WORKERS_VARIABLE", "SCATTER_BYTES"]
+           "WORK_PER_PIECE", "WORKERS_VARIABLE", "SCATTER_BYTES", "DASK_WORK_PER_PIECE",
+           "is_dask_client"]

@@ -46,6 +46,7 @@ from concurrent.futures.process import BrokenProcessPool
 from typing import Any, Callable, Iterator, Optional, Sequence
 
 from .jobs import Job, run_piece, run_stored_piece, store_job
+from .plan import is_dask_client
 
 __all__ = ["farm", "WorkerError", "pool_context", "shutdown_pools", "SCATTER_BYTES"]
 
@@ -93,7 +94,7 @@ def farm(job: Job, pieces: Sequence[Any], *, workers: int = 2, executor: Any = N
     total = sum(weights) or 1.0
     if executor is None:
         backend = _OwnPool(job, workers)
-    elif _is_dask(executor):
+    elif is_dask_client(executor):
         backend = _Dask(job, executor)
     else:
         backend = _Futures(job, executor)
@@ -114,11 +115,6 @@ def farm(job: Job, pieces: Sequence[Any], *, workers: int = 2, executor: Any = N
     finally:
         if not ok:
             backend.close()
-
-
-def _is_dask(executor: Any) -> bool:
-    return type(executor).__module__.split(".")[0] == "distributed" and \
-        callable(getattr(executor, "scatter", None))
 
 
 def _died(done: int, count: int, what: str, cause: BaseException) -> WorkerError:

@@ -17,7 +17,8 @@ import os
 from typing import Any, Optional
 
 __all__ = ["available_cores", "executor_workers", "plan_workers", "pieces_for", "split_evenly",
-           "MIN_PARALLEL_WORK", "PIECES_PER_WORKER", "WORK_PER_PIECE", "WORKERS_VARIABLE"]
+           "is_dask_client", "MIN_PARALLEL_WORK", "PIECES_PER_WORKER", "WORK_PER_PIECE",
+           "DASK_WORK_PER_PIECE", "WORKERS_VARIABLE"]
 
 #: below this much work (estimated surface voxels, or triangle pairs) a run with the
 #: default ``workers=None`` stays serial: starting processes and shipping results
@@ -26,6 +27,9 @@ MIN_PARALLEL_WORK = 1 << 18
 #: pieces per worker, at most: enough that uneven subtrees balance on the queue, few
 #: enough that each piece keeps full-sized batches
 PIECES_PER_WORKER = 8
+#: estimated voxels per piece on a Dask cluster (:func:`pieces_for`): about 0.1 s of
+#: work, against a round trip of about 15 ms per task (tests/benchmarks/bench_parallel.py)
+DASK_WORK_PER_PIECE = 1 << 21
 #: work per piece (surface voxels) below which a run is cut into fewer pieces, down to
 #: two per worker (each piece costs a few milliseconds of setting up, sorting and
 #: sending: measured in bench_parallel.py on the gear and the sponge)
@@ -81,15 +85,32 @@ def plan_workers(workers: Optional[int], executor: Any, work: float,
     return available_cores() if cores is None else cores
 
 
-def pieces_for(workers: int, work: float) -> int:
-    """How many pieces a run of ``work`` units on ``workers`` is cut into: one per
-    :data:`WORK_PER_PIECE`, from 2 to :data:`PIECES_PER_WORKER` per worker.
+def is_dask_client(executor: Any) -> bool:
+    """Whether ``executor`` is a ``dask.distributed.Client`` (without importing Dask)."""
+    return type(executor).__module__.split(".")[0] == "distributed" and \
+        callable(getattr(executor, "scatter", None))
 
-    >>> pieces_for(2, 2e6), pieces_for(2, 1e9), pieces_for(2, 10)
-    (4, 16, 4)
+
+def pieces_for(workers: int, work: float, executor: Any = None) -> int:
+    """How many pieces a run of ``work`` units on ``workers`` is cut into: one per
+    :data:`WORK_PER_PIECE`, from 2 to :data:`PIECES_PER_WORKER` per worker, rounded
+    up to a multiple of ``workers`` (the last round then keeps every worker busy:
+    7 pieces on 2 workers left one idle for a seventh of the run).
+
+    On a Dask ``executor`` each task costs a round trip through the scheduler
+    (measured: about 15 ms on this 2-core machine, where the scheduler's event
+    loop competes with the workers), so pieces are larger
+    (:data:`DASK_WORK_PER_PIECE`) and one per worker is allowed.
+
+    >>> pieces_for(2, 2e6), pieces_for(2, 1e9), pieces_for(2, 10), pieces_for(2, 3.4e6)
+    (4, 16, 4, 8)
     """
-    wanted = int(-(-work // WORK_PER_PIECE))
-    return max(2 * workers, min(PIECES_PER_WORKER * workers, wanted))
+    per_piece, least = WORK_PER_PIECE, 2
+    if executor is not None and is_dask_client(executor):
+        per_piece, least = DASK_WORK_PER_PIECE, 1
+    wanted = int(-(-work // per_piece))
+    pieces = max(least * workers, min(PIECES_PER_WORKER * workers, wanted))
+    return -(-pieces // workers) * workers
 
 
 def split_evenly(n: int, parts: int) -> list[tuple[int, int]]:
