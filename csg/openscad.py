@@ -42,10 +42,10 @@ Examples
 ...                   'sphere($fn = 0, $fa = 12, $fs = 2, r = 1.2); }')
 >>> s.bounds
 ((-1.0, -1.0, -1.0), (1.0, 1.0, 1.0))
->>> read_openscad('offset(r = 1) { square(size = 1); }')  # doctest: +ELLIPSIS
+>>> read_openscad('text(text = "hi", size = 10);')  # doctest: +ELLIPSIS
 Traceback (most recent call last):
 ...
-csg.openscad_parser.OpenSCADError: <csg>:1:1: module 'offset' is not supported (supported: ...)
+csg.openscad_parser.OpenSCADError: <csg>:1:1: module 'text' is not supported (supported: ...)
 """
 from __future__ import annotations
 
