@@ -38,7 +38,8 @@ import numpy as np
 from .planar import Circle, Polygon, Rectangle
 from .solid import Difference, Intersection, Solid, Transformed, Union
 
-__all__ = ["region_paths", "offset", "to_polygon", "clip", "to_clipper", "CLIPPER_SCALE",
+__all__ = ["region_paths", "region_pieces", "offset", "to_polygon", "clip", "to_clipper",
+           "CLIPPER_SCALE",
            "MITER_LIMIT", "NotFlat"]
 
 #: OpenSCAD 2021.01's ``ClipperUtils::CLIPPER_SCALE``: points are times this, truncated
@@ -115,6 +116,35 @@ def _leaf_outlines(solid: Solid) -> list[np.ndarray]:
         raise NotFlat("a true circle has no outline (facet it first, as OpenSCAD does: "
                       "read_openscad(..., facets='openscad'))")
     raise NotFlat(f"a {type(solid).__name__} is not a 2D shape with outlines")
+
+
+def region_pieces(solid: Solid) -> list[tuple[np.ndarray, list[np.ndarray]]]:
+    """A 2D tree's region as OpenSCAD computes it, in parts ``(outer, [holes])``
+    (float points; outer outlines counter-clockwise, holes clockwise: Clipper's
+    tree of outlines, islands in holes as parts of their own).
+
+    Raises
+    ------
+    NotFlat
+        As :func:`region_paths`.
+    """
+    import pyclipper
+    paths = _usable(region_paths(solid))
+    if not paths:
+        return []
+    clipper = pyclipper.Pyclipper()
+    clipper.AddPaths(paths, pyclipper.PT_SUBJECT, True)
+    tree = clipper.Execute2(pyclipper.CT_UNION, pyclipper.PFT_NONZERO, pyclipper.PFT_NONZERO)
+    pieces = []
+    stack = list(tree.Childs)
+    while stack:
+        node = stack.pop(0)
+        outer = np.asarray(node.Contour, dtype=np.float64) / CLIPPER_SCALE
+        holes = [np.asarray(h.Contour, dtype=np.float64) / CLIPPER_SCALE for h in node.Childs]
+        pieces.append((outer, [h for h in holes if len(h) >= 3]))
+        for hole in node.Childs:
+            stack.extend(hole.Childs)                 # islands inside the holes
+    return [(o, hs) for o, hs in pieces if len(o) >= 3]
 
 
 def to_polygon(paths: list) -> Optional[Polygon]:

@@ -13,10 +13,11 @@
   (width ``w``, mid-angle ``phi_k``) - an exact implicit form;
 * ``linear_extrude`` with twist or a non-uniform scale: ``slices`` layers
   with each side quad split into two triangles along its shorter diagonal,
-  as OpenSCAD does (a mesh). Without ``slices`` in the file, a
-  non-uniform scale is extruded in one slice (OpenSCAD 2021.01 picks its own
-  count, not reproduced: give ``slices``). A 2D boolean under such an extrusion
-  is extruded piece by piece (see ``_extrude_tree`` in :mod:`csg.openscad`).
+  as OpenSCAD does (a mesh). Without ``slices`` in the file, the count is
+  OpenSCAD 2021.01's (:func:`extrusion_slices`). A 2D boolean under such an
+  extrusion is first evaluated as OpenSCAD evaluates it, with Clipper
+  (:func:`csg.clipper2d.region_pieces`), and its outlines extruded as one mesh
+  (:func:`extrusion_mesh_outlines`).
 
 Examples
 --------
@@ -36,11 +37,11 @@ import numpy as np
 import implicitvox as iv
 from implicitvox import Expr, x, y
 
-from .triangulate import triangulate
 
 __all__ = ["fragments", "helix_slices", "conical_helix_slices", "diagonal_slices",
            "extrusion_slices", "circle_points", "sphere_points", "cylinder_points",
-           "polygonal_radius", "extrusion_mesh", "MAX_FRAGMENTS", "MAX_SPHERE_POINTS"]
+           "polygonal_radius", "extrusion_mesh", "extrusion_mesh_outlines", "MAX_FRAGMENTS",
+           "MAX_SPHERE_POINTS"]
 
 GRID_FINE = 0.00000095367431640625
 #: side-quad diagonals whose squared lengths differ by at most this share are equal
@@ -224,55 +225,79 @@ def polygonal_radius(n_sectors: int, angle: float) -> Expr:
 
 
 def extrusion_mesh(outline: np.ndarray, height: float, twist: float, scale: np.ndarray,
-                   slices: int, z0: float, extend: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
+                   slices: int, z0: float) -> tuple[np.ndarray, np.ndarray]:
     """Vertices and triangles of OpenSCAD's linear extrusion of one polygon outline.
 
     Layer ``i`` is the outline turned by ``-twist i / slices`` degrees, then scaled by
-    ``1 + (scale - 1) i / slices``, at ``z0 + height i / slices``. ``extend`` (a share
-    of the height) continues the end layers straight on beyond both ends, the walls
-    between the ends unchanged: a hole cut with it has no cap in or near the plane
-    of the solid's caps (coincident faces would leave a false layer of surface
-    voxels there).
+    ``1 + (scale - 1) i / slices``, at ``z0 + height i / slices``
+    (:func:`extrusion_mesh_outlines` of the outline alone).
     """
     poly = np.asarray(outline, dtype=np.float64)
     area = 0.5 * np.sum(poly[:, 0] * np.roll(poly[:, 1], -1) - np.roll(poly[:, 0], -1) * poly[:, 1])
-    if area < 0:
-        poly = poly[::-1]
-    k = len(poly)
-    layers = []
-    steps = [i / slices for i in range(slices + 1)]
-    for t in steps:
-        sx, sy = 1 + (scale[0] - 1) * t, 1 + (scale[1] - 1) * t
-        c, s = _cos_sin_degrees(-twist * t)
-        # OpenSCAD turns the section, then scales it: v = S R p
-        rx, ry = c * poly[:, 0] - s * poly[:, 1], s * poly[:, 0] + c * poly[:, 1]
-        layers.append(np.column_stack([rx * sx, ry * sy, np.full(k, z0 + height * t)]))
-    if extend > 0:
-        below, above = layers[0].copy(), layers[-1].copy()
-        below[:, 2] -= extend * height
-        above[:, 2] += extend * height
-        layers = [below] + layers + [above]
-        steps = [-extend] + steps + [1 + extend]
-    verts = np.concatenate(layers)
-    faces = []
-    for i in range(len(steps) - 1):
-        a, b = i * k, (i + 1) * k
-        for j in range(k):
+    return extrusion_mesh_outlines([(poly if area > 0 else poly[::-1], [])], height, twist,
+                                   scale, slices, z0)
+
+
+def extrusion_mesh_outlines(pieces: list, height: float, twist: float, scale: np.ndarray,
+                            slices: int, z0: float) -> tuple[np.ndarray, np.ndarray]:
+    """Vertices and triangles of OpenSCAD's linear extrusion of a 2D region, one closed
+    mesh, as OpenSCAD extrudes the result of its 2D booleans. ``pieces``: the
+    region's parts ``(outer, [holes])``, outer outlines counter-clockwise and holes
+    clockwise (as Clipper returns them: :func:`csg.clipper2d.region_pieces`).
+
+    Each side quad between two layers is split along its shorter diagonal (within a
+    relative :data:`DIAGONAL_TIE`, a tie, split by the twist's direction: measured
+    against OpenSCAD 2021.01's STL); the caps are each part triangulated with its holes
+    (`mapbox_earcut <https://github.com/skogler/mapbox_earcut_python>`_, Mapbox's
+    ear clipping for polygons with holes: a cap is planar, so any triangulation
+    of it is the same surface). Nothing is cut by a boolean afterwards, so where
+    two outlines of the 2D tree cross, the walls run through the crossing point as
+    OpenSCAD's do.
+    """
+    import mapbox_earcut
+    steps = np.arange(slices + 1) / slices
+    sx, sy = 1 + (scale[0] - 1) * steps, 1 + (scale[1] - 1) * steps
+    turns = [_cos_sin_degrees(-twist * t) for t in steps]
+    c, s = np.array([t[0] for t in turns]), np.array([t[1] for t in turns])
+    verts, faces = [], []
+    base = 0
+    for outer, holes in pieces:
+        rings = [np.asarray(r, dtype=np.float64) for r in (outer, *holes)]
+        starts = []
+        for ring in rings:
+            k = len(ring)
+            # layer i: the section turned, then scaled (v = S R p), at z0 + height t_i
+            rx = c[:, None] * ring[None, :, 0] - s[:, None] * ring[None, :, 1]
+            ry = s[:, None] * ring[None, :, 0] + c[:, None] * ring[None, :, 1]
+            layer = np.stack([rx * sx[:, None], ry * sy[:, None],
+                              np.broadcast_to((z0 + height * steps)[:, None], rx.shape)],
+                             axis=-1).reshape(-1, 3)
+            i, j = np.meshgrid(np.arange(slices), np.arange(k), indexing="ij")
             j1 = (j + 1) % k
-            # OpenSCAD splits a side quad along its shorter diagonal; diagonals within a
-            # relative 1e-5 of each other are a tie, which the twist's direction decides
-            # (measured against OpenSCAD 2021.01's STL: tests/csg/test_openscad_degenerate.py)
-            d1 = np.sum((verts[a + j] - verts[b + j1]) ** 2)
-            d2 = np.sum((verts[a + j1] - verts[b + j]) ** 2)
-            tie = abs(d1 - d2) <= DIAGONAL_TIE * max(d1, d2)
-            if (twist >= 0) if tie else d1 < d2:
-                faces.append((a + j, a + j1, b + j1))
-                faces.append((a + j, b + j1, b + j))
-            else:
-                faces.append((a + j, a + j1, b + j))
-                faces.append((a + j1, b + j1, b + j))
-    cap = triangulate(poly)
-    faces += [(c, b_, a_) for a_, b_, c in cap]                       # bottom, facing down
-    top = (len(steps) - 1) * k
-    faces += [(top + a_, top + b_, top + c) for a_, b_, c in cap]     # top, facing up
-    return verts, np.array(faces, dtype=np.int64)
+            a_j, a_j1 = i * k + j, i * k + j1
+            b_j, b_j1 = (i + 1) * k + j, (i + 1) * k + j1
+            # the shorter diagonal; a tie (within DIAGONAL_TIE) by the twist's direction
+            d1 = np.sum((layer[a_j] - layer[b_j1]) ** 2, axis=-1)
+            d2 = np.sum((layer[a_j1] - layer[b_j]) ** 2, axis=-1)
+            tie = np.abs(d1 - d2) <= DIAGONAL_TIE * np.maximum(d1, d2)
+            first = np.where(tie, twist >= 0, d1 < d2)[..., None, None]
+            split1 = np.stack([np.stack([a_j, a_j1, b_j1], -1), np.stack([a_j, b_j1, b_j], -1)], -2)
+            split2 = np.stack([np.stack([a_j, a_j1, b_j], -1), np.stack([a_j1, b_j1, b_j], -1)], -2)
+            faces.append(base + np.where(first, split1, split2).reshape(-1, 3))
+            verts.append(layer)
+            starts.append(base)
+            base += len(layer)
+        flat = np.concatenate(rings)
+        ends = np.cumsum([len(r) for r in rings]).astype(np.uint32)
+        tri = mapbox_earcut.triangulate_float64(flat, ends).reshape(-1, 3).astype(np.int64)
+        a, b, c3 = flat[tri[:, 0]], flat[tri[:, 1]], flat[tri[:, 2]]
+        area = (b[:, 0] - a[:, 0]) * (c3[:, 1] - a[:, 1]) - (b[:, 1] - a[:, 1]) * (c3[:, 0] - a[:, 0])
+        tri[area < 0] = tri[area < 0][:, ::-1]                    # counter-clockwise
+        # earcut's indices into the rings' points -> the mesh's bottom and top layers
+        owner = np.repeat(np.arange(len(rings)), [len(r) for r in rings])
+        local = np.concatenate([np.arange(len(r)) for r in rings])
+        bottom = np.asarray(starts)[owner] + local
+        upper = bottom + slices * np.array([len(r) for r in rings])[owner]
+        faces.append(bottom[tri[:, ::-1]])                         # bottom, facing down
+        faces.append(upper[tri])                                   # top, facing up
+    return np.concatenate(verts), np.concatenate(faces).astype(np.int64)

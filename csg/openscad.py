@@ -57,7 +57,7 @@ from typing import Any, Optional
 import numpy as np
 
 from . import facets as fx
-from .clipper2d import NotFlat, offset as clipped_offset
+from .clipper2d import NotFlat, offset as clipped_offset, region_pieces
 from .dxf import read_dxf
 from .projection import NotAMesh, projection as project
 from .heightmap import heightmap_mesh
@@ -81,9 +81,6 @@ SUPPORTED = ("group", "union", "difference", "intersection", "multmatrix", "cube
              "surface", "offset", "projection")
 #: OpenSCAD modules we know but do not voxelize
 UNSUPPORTED = ("text", "roof", "mirror", "rotate", "translate", "scale")
-#: how far (a share of the height) the prism of a hole runs past the caps of the twisted
-#: or scaled extrusion it is cut from (:func:`csg.facets.extrusion_mesh`)
-HOLE_EXTEND = 1.0
 #: the files ``import`` reads: triangle meshes (:func:`implicitvox.triangles.inputs.as_triangles`)
 #: and DXF drawings (:func:`csg.dxf.read_dxf`)
 IMPORT_SUFFIXES = (*MESH_SUFFIXES, ".dxf")
@@ -439,74 +436,27 @@ class _Builder:
         center = self.flag(node, "center")
         if not self.faceted or (twist == 0 and scale[0] == scale[1]):
             return LinearExtrude(body, h, twist, scale, center)
+        # OpenSCAD extrudes the result of its 2D booleans (Clipper): so does this
+        try:
+            pieces = region_pieces(body)
+        except NotFlat as err:
+            raise self.error(node, f"linear_extrude: {err}") from None
+        if not pieces:
+            return self.skip(node, "its 2D children leave no area")
         if node.args.get("slices") is not None:
             slices = self.number(node, "slices", 1.0)
         else:                                  # OpenSCAD computes them (calc.cc)
             fn, fs, fa = self.resolution(node)
-            slices = fx.extrusion_slices(self._outline_points(node, body), h, twist, scale,
-                                         fn, fs, fa, twisted="twist" in node.args)
+            points = np.concatenate([r for outer, holes in pieces for r in (outer, *holes)])
+            slices = fx.extrusion_slices(points, h, twist, scale, fn, fs, fa,
+                                         twisted="twist" in node.args)
         if not slices <= MAX_SLICES:
             raise self.error(node, f"linear_extrude: slices = {slices:.4g}, over the limit of "
                                    f"{MAX_SLICES} (csg.openscad.MAX_SLICES)")
         slices = max(int(slices), 1)
-        return self._extrude_tree(node, body, np.eye(4), (h, twist, scale, slices,
-                                                         -h / 2 if center else 0.0))
-
-    def _outline_points(self, node: Node, body: Solid, matrix: Optional[np.ndarray] = None
-                        ) -> np.ndarray:
-        """Every vertex (n, 2) of the outlines of a 2D tree, placed. OpenSCAD takes
-        them from the section after its 2D booleans, which may drop a vertex (one a
-        difference cuts away) or add one (where outlines cross): where that vertex
-        is the farthest from the axis, its slice count differs."""
-        matrix = np.eye(4) if matrix is None else matrix
-        if isinstance(body, Transformed):
-            return self._outline_points(node, body.children[0], matrix @ body.matrix)
-        if isinstance(body, (Union, Intersection, Difference)):
-            return np.concatenate([self._outline_points(node, c, matrix) for c in body.children])
-        points = np.concatenate(self._outlines(node, body))
-        return points @ matrix[:2, :2].T + matrix[:2, 3]
-
-    def _outlines(self, node: Node, body: Solid) -> list[np.ndarray]:
-        """The outlines (each (m, 2)) of a 2D leaf in OpenSCAD's facets; a polygon's
-        in the order of its even-odd pieces (:attr:`Polygon.pieces`)."""
-        if isinstance(body, Rectangle):
-            lo = -body.size / 2 if body.centered else np.zeros(2)
-            hi = lo + body.size
-            return [np.array([[lo[0], lo[1]], [hi[0], lo[1]], [hi[0], hi[1]], [lo[0], hi[1]]])]
-        if isinstance(body, Polygon):
-            return [body.points[body.paths[k]] for piece in body.pieces
-                    for k in (piece[0], *piece[1])]
-        raise self.error(node, f"facets='openscad': cannot extrude a {type(body).__name__} "
-                               "with twist or an uneven scale (use facets='true')")
-
-    def _extrude_tree(self, node: Node, body: Solid, matrix: np.ndarray, params) -> Solid:
-        """OpenSCAD's sliced extrusion of a 2D CSG tree: each leaf outline is extruded as
-        a mesh and the meshes are combined by the same booleans (holes become
-        differences). On every slice this is exactly OpenSCAD's section; between slices,
-        where two outlines cross, OpenSCAD's walls run through the crossing point and
-        ours through each outline's own edges - they differ by second-order amounts
-        there (a few voxels along the crossing)."""
-        if isinstance(body, Transformed):
-            return self._extrude_tree(node, body.children[0], matrix @ body.matrix, params)
-        if isinstance(body, (Union, Intersection, Difference)):
-            kids = [self._extrude_tree(node, c, matrix, params) for c in body.children]
-            return type(body)(*kids)
-        def prism(pts: np.ndarray, extend: float = 0.0) -> Solid:
-            v, f = fx.extrusion_mesh(pts @ matrix[:2, :2].T + matrix[:2, 3], *params,
-                                     extend=extend)
-            return Polyhedron(v, f)
-
-        if isinstance(body, Polygon):          # even-odd: each piece minus its holes
-            pieces = []
-            for outer, holes in body.pieces:
-                solid = prism(body.points[body.paths[outer]])
-                if holes:
-                    # holes reach past the caps: no coincident cap faces
-                    solid = Difference(solid, *[prism(body.points[body.paths[h]], HOLE_EXTEND)
-                                                for h in holes])
-                pieces.append(solid)
-            return pieces[0] if len(pieces) == 1 else Union(*pieces)
-        return prism(self._outlines(node, body)[0])
+        v, f = fx.extrusion_mesh_outlines(pieces, h, twist, scale, slices,
+                                          -h / 2 if center else 0.0)
+        return Polyhedron(v, f)
 
     def _rotate_extrude(self, node: Node) -> Optional[Solid]:
         body = self._section(node)
