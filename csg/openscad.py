@@ -14,12 +14,13 @@ facets, as OpenSCAD does), ``surface`` (heightmaps, ``.dat`` or PNG, as
 OpenSCAD's mesh: :mod:`csg.heightmap`), ``offset`` (``r``, ``delta``,
 ``chamfer``: with Clipper, as OpenSCAD computes it, :mod:`csg.clipper2d`),
 ``projection`` (the section by z = 0 through any boolean, or the shadow of
-meshes and polytopes: :mod:`csg.projection`), with
-``$fn, $fa, $fs``, and OpenSCAD's
+meshes and polytopes: :mod:`csg.projection`), ``text`` (the glyph outlines
+OpenSCAD 2021.01 draws, with fontconfig, HarfBuzz and FreeType:
+:mod:`csg.text`), with ``$fn, $fa, $fs``, and OpenSCAD's
 modifiers as its ``.csg`` export writes them: ``%`` (background) and ``*``
 (disabled) drop their subtree, ``#`` (highlight) keeps it, ``!`` (root) makes
 its subtree the whole design. Any other module
-(``text``, ``roof``, ...) is
+(``roof``, ...) is
 refused with its name, line and column. Nothing is evaluated.
 
 Degenerate input is skipped, as OpenSCAD skips it, with an
@@ -42,10 +43,10 @@ Examples
 ...                   'sphere($fn = 0, $fa = 12, $fs = 2, r = 1.2); }')
 >>> s.bounds
 ((-1.0, -1.0, -1.0), (1.0, 1.0, 1.0))
->>> read_openscad('text(text = "hi", size = 10);')  # doctest: +ELLIPSIS
+>>> read_openscad('roof() square(size = [2, 2]);')  # doctest: +ELLIPSIS
 Traceback (most recent call last):
 ...
-csg.openscad_parser.OpenSCADError: <csg>:1:1: module 'text' is not supported (supported: ...)
+csg.openscad_parser.OpenSCADError: <csg>:1:1: module 'roof' is not supported (supported: ...)
 """
 from __future__ import annotations
 
@@ -60,6 +61,7 @@ from . import facets as fx
 from .clipper2d import NotFlat, offset as clipped_offset, region_pieces
 from .dxf import read_dxf
 from .projection import NotAMesh, projection as project
+from .text import text_polygon
 from .heightmap import heightmap_mesh
 from .openscad_parser import Node, OpenSCADError, OpenSCADWarning, parse
 from .planar import Circle, LinearExtrude, Polygon, Rectangle, RotateExtrude
@@ -78,9 +80,9 @@ MAX_SLICES = 10_000
 SUPPORTED = ("group", "union", "difference", "intersection", "multmatrix", "cube", "sphere",
              "cylinder", "polyhedron", "circle", "square", "polygon", "linear_extrude",
              "rotate_extrude", "color", "render", "import", "hull", "minkowski", "resize",
-             "surface", "offset", "projection")
+             "surface", "offset", "projection", "text")
 #: OpenSCAD modules we know but do not voxelize
-UNSUPPORTED = ("text", "roof", "mirror", "rotate", "translate", "scale")
+UNSUPPORTED = ("roof", "mirror", "rotate", "translate", "scale")
 #: the files ``import`` reads: triangle meshes (:func:`implicitvox.triangles.inputs.as_triangles`)
 #: and DXF drawings (:func:`csg.dxf.read_dxf`)
 IMPORT_SUFFIXES = (*MESH_SUFFIXES, ".dxf")
@@ -139,6 +141,17 @@ def read_openscad(path_or_text: Any, facets: str = "true", base: Any = None) -> 
                             "(linear_extrude, rotate_extrude) first", first.line, first.column,
                             source)
     return solid
+
+
+def _holds_text(node: Node) -> bool:
+    """Whether a ``text`` node is below ``node``."""
+    stack = list(node.children)
+    while stack:
+        child = stack.pop()
+        if child.name == "text":
+            return True
+        stack.extend(child.children)
+    return False
 
 
 def _root_node(nodes: list[Node]) -> Optional[Node]:
@@ -412,6 +425,29 @@ class _Builder:
             raise self.error(node, "polygon: paths must be lists of point indices")
         return Polygon(p, None if paths is None else [[int(i) for i in q] for q in paths])
 
+    def _text(self, node: Node) -> Optional[Solid]:
+        """OpenSCAD's ``text``: the polygon of its glyph outlines as OpenSCAD 2021.01
+        draws them (:func:`csg.text.text_polygon`), the same in both facet modes
+        (OpenSCAD's curves are part of the model: its outlines are sampled by its
+        own rule); a text that draws nothing (spaces) is skipped with a warning."""
+        words = self.arg(node, "text", None, 0)
+        if not isinstance(words, str):
+            raise self.error(node, f"text: text must be a string, got {words!r:.40}")
+        options = {}
+        for name in ("font", "halign", "valign", "direction", "language", "script"):
+            value = self.arg(node, name, None)
+            if value is not None and not isinstance(value, str):
+                raise self.error(node, f"text: {name} must be a string, got {value!r:.40}")
+            if value is not None:
+                options[name] = value
+        fn, fs, fa = self.resolution(node)
+        polygon = text_polygon(words, self.number(node, "size", 10.0, 1, positive=True),
+                               spacing=self.number(node, "spacing", 1.0), fn=fn, fs=fs,
+                               fa=fa, **options)
+        if polygon is None:
+            return self.skip(node, f"{words!r:.40} draws no glyph outline")
+        return polygon
+
     def _section(self, node: Node) -> Optional[Solid]:
         """The 2D children of an extrusion, united (None when there are none); 3D
         children are skipped with a warning, as OpenSCAD does."""
@@ -434,8 +470,11 @@ class _Builder:
         twist = self.number(node, "twist", 0.0)
         scale = self.vector(node, "scale", 2, 1.0)
         center = self.flag(node, "center")
-        if not self.faceted or (twist == 0 and scale[0] == scale[1]):
+        straight = twist == 0 and scale[0] == scale[1]
+        if not _holds_text(node) and (not self.faceted or straight):
             return LinearExtrude(body, h, twist, scale, center)
+        # OpenSCAD's glyph outlines are long non-convex polygons whose function
+        # encloses loosely over a box: their extrusion is taken as its mesh, as below
         # OpenSCAD extrudes the result of its 2D booleans (Clipper): so does this
         try:
             pieces = region_pieces(body)
@@ -443,7 +482,9 @@ class _Builder:
             raise self.error(node, f"linear_extrude: {err}") from None
         if not pieces:
             return self.skip(node, "its 2D children leave no area")
-        if node.args.get("slices") is not None:
+        if straight:
+            slices = 1.0
+        elif node.args.get("slices") is not None:
             slices = self.number(node, "slices", 1.0)
         else:                                  # OpenSCAD computes them (calc.cc)
             fn, fs, fa = self.resolution(node)

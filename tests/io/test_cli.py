@@ -99,7 +99,7 @@ def test_openscad_and_json_models(tmp_path, capsys):
 
 @pytest.mark.parametrize("content, suffix, match", [
     ("cube(size = 1)", ".csg", r":1:15: expected ';'"),
-    ('text(text = "hi", size = 10);', ".csg", "module 'text' is not supported"),
+    ('roof() square(size = [1, 1]);', ".csg", "module 'roof' is not supported"),
     ('{"implicitvox_scene": 1, "root": {"type": "sphere"}}', ".json", r"root\.r"),
     ("solid x", ".step", "unsupported model type '.step'"),
 ])
