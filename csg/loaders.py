@@ -10,12 +10,12 @@ from .scene import load_json
 __all__ = ["load_csg", "load_scene"]
 
 
-
-def load_csg(path: str, facets: str = "true") -> Any:
-    """An OpenSCAD ``.csg`` file as a solid (true curves, or ``facets="openscad"``)."""
+def load_csg(path: str, facets: str = "openscad") -> Any:
+    """An OpenSCAD ``.csg`` file as a solid (OpenSCAD's facets, or true curves with
+    ``facets="true"``)."""
     return read_openscad(path, facets=facets)
 
 
-def load_scene(path: str, facets: str = "true") -> Any:
+def load_scene(path: str, facets: str = "openscad") -> Any:
     """A JSON scene file as a solid (``facets`` does not apply)."""
     return load_json(path)

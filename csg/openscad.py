@@ -31,11 +31,13 @@ child of an extrusion, an invalid polyhedron. The rest of the file is read.
 A file whose design is 2D (OpenSCAD would export DXF or SVG) is refused at
 read time, saying so.
 
-``facets="true"`` (default) voxelizes the true curved primitives;
-``facets="openscad"`` reproduces OpenSCAD's own polygonization
+``facets="openscad"`` (default) reproduces OpenSCAD's own polygonization
 (:mod:`csg.facets`): spheres and cylinders become the convex polyhedra
 OpenSCAD builds, circles its polygons, ``rotate_extrude`` its sectors, and a
-twisted or unevenly scaled ``linear_extrude`` its sliced mesh.
+twisted or unevenly scaled ``linear_extrude`` its sliced mesh, so a ``$fn = 6``
+cylinder is the hexagonal prism OpenSCAD renders and exports.
+``facets="true"`` voxelizes the true curved primitives the file's ``$fn, $fa,
+$fs`` only approximate.
 
 Examples
 --------
@@ -88,15 +90,16 @@ UNSUPPORTED = ("roof", "mirror", "rotate", "translate", "scale")
 IMPORT_SUFFIXES = (*MESH_SUFFIXES, ".dxf")
 
 
-def read_openscad(path_or_text: Any, facets: str = "true", base: Any = None) -> Solid:
+def read_openscad(path_or_text: Any, facets: str = "openscad", base: Any = None) -> Solid:
     """Read a ``.csg`` file (path) or its text into a solid.
 
     Parameters
     ----------
     path_or_text : str or os.PathLike
         A path to a ``.csg`` file, or ``.csg`` text (anything containing ``(``).
-    facets : {"true", "openscad"}
-        Voxelize true curves, or OpenSCAD's facets.
+    facets : {"openscad", "true"}
+        OpenSCAD's own facets (the solid OpenSCAD renders and exports), or the
+        true curves they approximate.
     base : str or os.PathLike, optional
         The folder ``import(file = ...)`` paths are relative to: by default the
         ``.csg`` file's own (OpenSCAD writes them relative to the ``.scad``

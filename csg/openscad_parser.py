@@ -30,13 +30,35 @@ import re
 from dataclasses import dataclass, field
 from typing import Any, Optional
 
-__all__ = ["OpenSCADError", "Node", "parse", "tokenize", "MAX_DEPTH", "MAX_TOKENS"]
+__all__ = ["OpenSCADError", "Node", "parse", "tokenize", "unescape", "MAX_DEPTH", "MAX_TOKENS"]
 
 #: nesting depth limit (modules and vectors); the parser recurses, so this stays well
 #: inside Python's recursion limit
 MAX_DEPTH = 200
 #: token limit (a 100 MB file); larger input is refused
 MAX_TOKENS = 20_000_000
+
+
+
+_ESCAPE = re.compile(r"\\(?:x([0-7][0-9a-fA-F])|u([0-9a-fA-F]{4})|U([0-9a-fA-F]{6})|(.))",
+                     re.DOTALL)
+_SIMPLE_ESCAPES = {"n": "\n", "t": "\t", "r": "\r", '"': '"', "\\": "\\"}
+
+
+def unescape(body: str) -> str:
+    """A string literal's text (without its quotes) with OpenSCAD's escapes
+    (``\\n \\t \\r \\" \\\\``, ``\\xHH`` up to 7F, ``\\uHHHH``, ``\\UHHHHHH``) decoded;
+    any other character, non-ASCII too, stands for itself.
+
+    >>> unescape(r'a\\"b\\u263C') == 'a"b\u263c'
+    True
+    """
+    def one(m: re.Match) -> str:
+        code = m.group(1) or m.group(2) or m.group(3)
+        if code is not None:
+            return chr(min(int(code, 16), 0x10FFFF))
+        return _SIMPLE_ESCAPES.get(m.group(4), m.group(0))
+    return _ESCAPE.sub(one, body)
 
 
 class OpenSCADError(ValueError):
@@ -227,7 +249,7 @@ class _Parser:
             return float(t.text)
         if t.kind == "string":
             self.i += 1
-            return bytes(t.text[1:-1], "utf-8").decode("unicode_escape")
+            return unescape(t.text[1:-1])
         if t.kind == "ident" and t.text in ("true", "false", "undef", "inf", "nan"):
             self.i += 1
             return {"true": True, "false": False, "undef": None,

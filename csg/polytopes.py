@@ -9,10 +9,11 @@ their vertices, and the sum distributes over unions,
 union of convex polytopes. Both are exact (up to the rounding of the sums)
 and are what OpenSCAD's ``hull`` and ``minkowski`` compute on its facets.
 
-What has no vertex set raises :class:`NotAPolytope` saying why: a curved
-solid (a true sphere or cylinder: the hull of spheres is not a polytope), or a
-difference or intersection (its vertices are those of the boolean's result,
-which is never built here), or a non-convex piece of a Minkowski sum.
+The hull of a difference or intersection is that of the boolean's result, computed
+first as OpenSCAD computes it: in 2D by Clipper, in 3D by Manifold
+(:mod:`csg.tree_mesh`). What has no vertex set raises :class:`NotAPolytope` saying
+why: a curved solid (a true sphere or cylinder: the hull of spheres is not a
+polytope), or a non-convex piece of a Minkowski sum (a difference among them).
 
 Examples
 --------
@@ -34,9 +35,11 @@ from typing import Any
 
 import numpy as np
 
+from .clipper2d import CLIPPER_SCALE, NotFlat, region_paths
 from .planar import Circle, LinearExtrude, Polygon, Rectangle
 from .primitives import Box, ConvexPolyhedron, Cylinder, Ellipsoid, Polyhedron, Sphere, Torus
 from .solid import Solid, Transformed, Union
+from .tree_mesh import NotAMesh, tree_mesh
 
 __all__ = ["hull", "minkowski", "vertices", "convex_pieces", "convex_solid", "NotAPolytope",
            "MAX_PLANES", "MAX_PIECES", "MAX_SUMS"]
@@ -53,8 +56,8 @@ _CURVED = (Sphere, Cylinder, Torus, Ellipsoid, Circle)
 
 
 class NotAPolytope(ValueError):
-    """A solid with no vertex set: curved, a difference or intersection, or (for a
-    Minkowski sum) a non-convex piece."""
+    """A solid with no vertex set: curved, or (for a Minkowski sum) a non-convex
+    piece."""
 
     def __init__(self, message: str, curved: bool = False):
         super().__init__(message)
@@ -69,7 +72,7 @@ def vertices(solid: Solid) -> np.ndarray:
     Raises
     ------
     NotAPolytope
-        A curved leaf, a difference or an intersection, a twisted or scaled extrusion.
+        A curved leaf, a twisted extrusion, an empty boolean.
     """
     return np.concatenate(convex_pieces(solid, convex=False))
 
@@ -150,10 +153,36 @@ def _leaf_vertices(solid: Solid, convex: bool) -> np.ndarray:
         top = np.column_stack([flat * solid.scale_top, np.full(len(flat), z0 + solid.height)])
         return np.concatenate([bottom, top])
     if name in ("Difference", "Intersection"):
-        raise NotAPolytope(f"a {name.lower()}'s vertices are those of the boolean's result, "
-                           "which is not built here (only unions of polytopes are taken)")
+        if convex:
+            raise NotAPolytope(f"a {name.lower()} in a Minkowski sum (its result is not "
+                               "convex in general, and its convex decomposition is not "
+                               "built: split it into convex parts)")
+        return _boolean_vertices(solid)
     raise NotAPolytope(f"a {name} has no vertex set here (hull and minkowski take boxes, "
                        "polyhedra, polygons, straight extrusions, moved and united)")
+
+
+def _boolean_vertices(solid: Solid) -> np.ndarray:
+    """The vertices of a difference's or intersection's result: in 2D the Clipper
+    outlines OpenSCAD computes (:func:`csg.clipper2d.region_paths`), in 3D the mesh
+    Manifold computes (:func:`csg.tree_mesh.tree_mesh`), as OpenSCAD computes the
+    boolean (CGAL) before its hull."""
+    if solid.dim == 2:
+        try:
+            paths = region_paths(solid)
+        except NotFlat as err:
+            raise NotAPolytope(str(err), curved=True) from None
+        if not paths:
+            raise NotAPolytope(f"the {type(solid).__name__.lower()} is empty: no vertices")
+        flat = np.concatenate([np.asarray(q, dtype=np.float64) for q in paths]) / CLIPPER_SCALE
+        return np.column_stack([flat, np.zeros(len(flat))])
+    try:
+        v, f = tree_mesh(solid, np.eye(4))
+    except NotAMesh as err:
+        raise NotAPolytope(str(err), curved=err.curved) from None
+    if not len(f):
+        raise NotAPolytope(f"the {type(solid).__name__.lower()} is empty: no vertices")
+    return v[np.unique(f.ravel())]
 
 
 def _is_convex_polygon(poly: np.ndarray) -> bool:

@@ -12,14 +12,14 @@
   hanging from z = 0, where this gives nothing).
 * ``cut=False``: the shadow on z = 0, the union of every triangle projected,
   as OpenSCAD's ``PolysetUtils::project`` and Clipper's non-zero union make it.
-  A shadow distributes over unions only: a difference or intersection below
-  it is refused, saying so.
+  A shadow distributes over unions only: below a difference or intersection the
+  boolean's result is computed as a mesh first (:func:`csg.tree_mesh.tree_mesh`,
+  by Manifold), as OpenSCAD computes it (CGAL) before projecting.
 
-Leaves: :class:`~csg.primitives.Polyhedron` (imported meshes, ``surface``,
-polyhedra), :class:`~csg.primitives.ConvexPolyhedron` given by points (OpenSCAD's
-faceted spheres and cylinders), :class:`~csg.primitives.Box`, moved by any
-``multmatrix``. A curved leaf raises :class:`NotAMesh` (``curved`` set: the
-reader then takes OpenSCAD's facets, with a warning).
+Leaves: those of :func:`csg.tree_mesh.leaf_mesh` (polyhedra, imported meshes,
+surfaces, boxes, faceted primitives), moved by any ``multmatrix``. A curved
+leaf raises :class:`~csg.tree_mesh.NotAMesh` (``curved`` set: the reader then
+takes OpenSCAD's facets, with a warning).
 
 Examples
 --------
@@ -39,46 +39,10 @@ import numpy as np
 
 from .clipper2d import clip, to_clipper, to_polygon
 from .planar import Polygon
-from .primitives import (Box, ConvexPolyhedron, Cylinder, Ellipsoid, Polyhedron, Sphere,
-                         Torus)
 from .solid import Difference, Intersection, Solid, Transformed, Union
+from .tree_mesh import NotAMesh, leaf_mesh, tree_mesh
 
 __all__ = ["projection", "leaf_mesh", "section_outlines", "NotAMesh"]
-
-_CURVED = (Sphere, Cylinder, Torus, Ellipsoid)
-
-
-class NotAMesh(ValueError):
-    """A 3D leaf with no triangle mesh (curved), or a shadow of a difference or
-    intersection."""
-
-    def __init__(self, message: str, curved: bool = False):
-        super().__init__(message)
-        #: the reason is a curved leaf (its facets would do)
-        self.curved = curved
-
-
-def leaf_mesh(solid: Solid, matrix: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """The closed triangle mesh (vertices, faces) of a polytope leaf, moved by ``matrix``."""
-    from scipy.spatial import ConvexHull
-    if isinstance(solid, _CURVED):
-        raise NotAMesh(f"a {type(solid).__name__} is curved: it has no mesh to project "
-                       "(facet it first: read_openscad(..., facets='openscad'))", curved=True)
-    if isinstance(solid, Polyhedron):
-        v, f = solid.vertices, solid.faces
-    elif isinstance(solid, ConvexPolyhedron) and solid.points is not None:
-        v = solid.points
-        f = ConvexHull(v).simplices
-    elif isinstance(solid, Box):
-        lo = -solid.size / 2 if solid.centered else np.zeros(3)
-        v = lo + np.array([[i, j, k] for i in (0, 1) for j in (0, 1) for k in (0, 1)]) * solid.size
-        f = ConvexHull(v).simplices
-    else:
-        raise NotAMesh(f"a {type(solid).__name__} has no triangle mesh here (projection takes "
-                       "polyhedra, imported meshes, surfaces, boxes and faceted primitives)",
-                       curved=type(solid).__name__ in ("LinearExtrude", "RotateExtrude"))
-    return v @ matrix[:3, :3].T + matrix[:3, 3], np.asarray(f)
-
 
 def section_outlines(vertices: np.ndarray, faces: np.ndarray) -> list[np.ndarray]:
     """The closed outlines (each (k, 2)) where the plane z = 0 cuts a closed mesh
@@ -146,10 +110,10 @@ def _shadow_paths(solid: Solid, matrix: np.ndarray) -> list:
     if isinstance(solid, Union):
         return clip([p for c in solid.children for p in _shadow_paths(c, matrix)], [],
                      "CT_UNION")
-    if isinstance(solid, (Difference, Intersection)):
-        raise NotAMesh(f"the shadow of a {type(solid).__name__.lower()} needs the boolean's "
-                       "result, which is not built here (projection(cut = true) is exact)")
-    v, f = leaf_mesh(solid, matrix)
+    # the shadow of a difference or intersection is that of the boolean's result
+    v, f = tree_mesh(solid, matrix)
+    if not len(f):
+        return []
     tri = v[f][:, :, :2]
     u, w = tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]
     area = u[:, 0] * w[:, 1] - u[:, 1] * w[:, 0]
@@ -165,7 +129,7 @@ def projection(solid: Solid, cut: bool = False) -> Optional[Polygon]:
     Raises
     ------
     NotAMesh
-        A curved leaf, or (``cut=False``) a difference or intersection.
+        A curved leaf, or (``cut=False``) a boolean of meshes that are not closed.
     """
     paths = _cut_paths(solid, np.eye(4)) if cut else _shadow_paths(solid, np.eye(4))
     return to_polygon(paths)

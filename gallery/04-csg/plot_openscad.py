@@ -17,7 +17,7 @@ HERE = Path(__file__).resolve().parent
 
 # %%
 for name in ("bracket", "knob"):
-    solid = read_openscad(HERE / f"{name}.csg")
+    solid = read_openscad(HERE / f"{name}.csg", facets="true")
     vox = solid.voxelize(RESOLUTION, interior=True)
     print(vox.render(out(f"{name}.png"), title=f"{name}.scad, {vox.count:,} surface voxels"),
           vox.count)

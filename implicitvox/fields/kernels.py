@@ -31,6 +31,7 @@ from typing import Any, Callable, Optional
 import numpy as np
 
 from ..expr.shape import AMBIGUOUS, FULL, voxel_classifier
+from ..linf.classify import TIE_ULPS
 from ..linf.norm import float_bisection
 
 __all__ = ["Kernel", "choose_kernel", "exact_distance_function", "linf_by_box_test"]
@@ -73,7 +74,7 @@ def linf_by_box_test(classify: Callable, points: np.ndarray, weights: Any,
                      limit: float = np.inf) -> tuple[np.ndarray, np.ndarray]:
     """Signed weighted max-norm distances from an exact box test, by bisection on the
     bit patterns of the cube's half-size (64 steps at most); error one ulp of the
-    distance. ``limit`` caps the search (points farther get ``±limit``)."""
+    distance plus the box test's allowance for rounding (``linf.classify.TIE_ULPS``). ``limit`` caps the search (points farther get ``±limit``)."""
     p = np.asarray(points, dtype=np.float64)
     n = len(p)
     w = np.ones((n, 3)) if weights is None else \
@@ -99,4 +100,9 @@ def linf_by_box_test(classify: Callable, points: np.ndarray, weights: Any,
         inside = classify(p - t_lo[:, None] * w, p + t_lo[:, None] * w) == FULL
     far = ~meets(hi)
     t = np.where(far, hi, t)
-    return np.where(inside & ~at_lo, -t, t), np.where(at_lo | far, 0.0, t_hi - t_lo)
+    # the box test counts a cube within its rounding of touching as met
+    # (linf.classify.TIE_ULPS, in units of the centre's ulp over the half-size): the
+    # distance may be that much short, taken twice for the distance's own rounding
+    reach = np.abs(p).max(axis=1) / w.min(axis=1)
+    tie = 2 * TIE_ULPS * np.finfo(np.float64).eps * (2 * t + reach)
+    return np.where(inside & ~at_lo, -t, t), np.where(far, 0.0, (t_hi - t_lo) * ~at_lo + tie)

@@ -6,7 +6,8 @@
     implicitvox voxelize --example sinsin34 --resolution 256 --render sinsin.png
     implicitvox voxelize model.py --resolution 512 --bounds -1 -1 -1 1 1 1 --out model.npz
     implicitvox voxelize bunny.obj --resolution 256 --interior --render bunny.png
-    implicitvox voxelize bracket.csg --facets openscad --resolution 256 --out bracket.npz
+    implicitvox voxelize bracket.csg --resolution 256 --out bracket.npz   # OpenSCAD's facets
+    implicitvox voxelize bracket.csg --facets true --resolution 256      # true curves
     implicitvox mesh --example gear --tolerance 0.01 --out gear.stl --render gear.png
     implicitvox field --example gear --resolution 256 --band 4 --out gear-sdf.vti
     implicitvox field bunny.obj --norm linf --resolution 256 --check-suitability
@@ -150,8 +151,8 @@ def _parser() -> argparse.ArgumentParser:
     size.add_argument("--voxel-size", type=float, metavar="H", help="the voxels' edge length")
     vox.add_argument("--bounds", type=float, nargs=6, metavar=("X0", "Y0", "Z0", "X1", "Y1", "Z1"))
     vox.add_argument("--interior", action="store_true", help="also find interior octants")
-    vox.add_argument("--facets", choices=["true", "openscad"], default="true",
-                     help=".csg models: true curves, or OpenSCAD's own facets")
+    vox.add_argument("--facets", choices=["openscad", "true"], default="openscad",
+                     help=".csg models: OpenSCAD's own facets (default), or true curves")
     vox.add_argument("--normals", action="store_true", help="store normals")
     vox.add_argument("--mean-value", action="store_true",
                      help="tighter: mean value form on ambiguous octants (about 3x the time)")
@@ -183,8 +184,8 @@ def _parser() -> argparse.ArgumentParser:
                      help="voxels around the surface (default 4; 0: every voxel)")
     fld.add_argument("--tolerance", type=float, metavar="E",
                      help="error target of certified distances (default 1e-3 voxel)")
-    fld.add_argument("--facets", choices=["true", "openscad"], default="true",
-                     help=".csg models: true curves, or OpenSCAD's own facets")
+    fld.add_argument("--facets", choices=["openscad", "true"], default="openscad",
+                     help=".csg models: OpenSCAD's own facets (default), or true curves")
     fld.add_argument("--out", help="write .npz (lossless) or .vti")
     fld.add_argument("--render", metavar="PNG", help="render the 0-isosurface")
     fld.add_argument("--check-suitability", action="store_true",
@@ -203,8 +204,8 @@ def _parser() -> argparse.ArgumentParser:
     size.add_argument("--resolution", type=int,
                       help="cells along the longest side (the bound is sqrt(3) cells)")
     msh.add_argument("--bounds", type=float, nargs=6, metavar=("X0", "Y0", "Z0", "X1", "Y1", "Z1"))
-    msh.add_argument("--facets", choices=["true", "openscad"], default="true",
-                     help=".csg models: true curves, or OpenSCAD's own facets")
+    msh.add_argument("--facets", choices=["openscad", "true"], default="openscad",
+                     help=".csg models: OpenSCAD's own facets (default), or true curves")
     msh.add_argument("--refine", type=int, default=REFINE, metavar="K",
                      help=f"levels complex cells may be split below the largest (default {REFINE})")
     msh.add_argument("--no-prune", dest="prune", action="store_false",

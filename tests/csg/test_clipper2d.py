@@ -72,11 +72,11 @@ def test_true_circles_are_refused_or_faceted_with_a_warning():
            "{ circle($fn = 12, $fa = 12, $fs = 2, r = 1); }"
     faceted = csg.read_openscad(text, facets="openscad")
     with pytest.warns(csg.OpenSCADWarning, match="offset: its circles are taken as OpenSCAD"):
-        true = csg.read_openscad(text)
+        true = csg.read_openscad(text, facets="true")
     assert np.allclose(true.children[0].points, faceted.children[0].points)
     with pytest.warns(csg.OpenSCADWarning, match="leaves nothing"):
         csg.read_openscad("linear_extrude(1) offset(r = -2, $fn = 8) { square(size = 1); }"
-                          "cube(size = 1);")
+                          "cube(size = 1);", facets="true")
     with pytest.raises(ValueError, match="join must be one of"):
         offset(Rectangle((1, 1)), 1.0, "bevel")
     assert math.isclose(CLIPPER_SCALE, 65536.0)

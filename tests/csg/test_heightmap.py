@@ -82,7 +82,7 @@ def test_bad_files_are_named(tmp_path, monkeypatch):
 def test_surface_in_a_csg_file(tmp_path):
     (tmp_path / "h.dat").write_text("0 1\n1 2\n")
     solid = csg.read_openscad('surface(file = "h.dat", center = true, invert = false);',
-                              base=tmp_path)
+                              base=tmp_path, facets="true")
     assert solid.bounds == ((-0.5, -0.5, -1.0), (0.5, 0.5, 2.0))
     with pytest.warns(csg.OpenSCADWarning, match="surface: cannot open"):
-        csg.read_openscad('surface(file = "gone.dat"); cube(1);', base=tmp_path)
+        csg.read_openscad('surface(file = "gone.dat"); cube(1);', base=tmp_path, facets="true")

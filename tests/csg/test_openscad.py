@@ -133,7 +133,7 @@ def test_true_curves_within_facet_tolerance(model):
     """Every sampled point of OpenSCAD's faceted surface lies within the facets'
     chordal tolerance of a voxel of the true-curve voxelization."""
     stl = _stl_voxels(model)
-    solid = read_openscad(FIXTURES / f"{model}.csg")
+    solid = read_openscad(FIXTURES / f"{model}.csg", facets="true")
     vox = solid.voxelize(bounds=stl.bounds, voxel_size=stl.voxel_size)
     v, f = as_triangles(str(FIXTURES / f"{model}.stl"))
     pts = sample_surface(v[f], 100_000, np.random.default_rng(0))
@@ -173,7 +173,7 @@ BAD = [
 @pytest.mark.parametrize("text, message, where", BAD)
 def test_malformed_csg(text, message, where):
     with pytest.raises(OpenSCADError, match=re.escape(message)) as err:
-        read_openscad(text)
+        read_openscad(text, facets="true")
     assert (err.value.line, err.value.column) == where
 
 
@@ -181,21 +181,21 @@ def test_malformed_csg(text, message, where):
 def test_unsupported_modules_are_named(module):
     text = f"group() {{\n  {module}() {{ cube(size = 1); }}\n}}"
     with pytest.raises(OpenSCADError, match=f"module '{module}' is not supported") as err:
-        read_openscad(text)
+        read_openscad(text, facets="true")
     assert (err.value.line, err.value.column) == (2, 3)
 
 
 def test_hostile_nesting_and_size_fail_fast():
     deep = "group() {" * 5000 + "cube(size = 1);" + "}" * 5000
     with pytest.raises(OpenSCADError, match="nesting deeper|nesting too deep"):
-        read_openscad(deep)
+        read_openscad(deep, facets="true")
     vec = "cube(size = " + "[" * 5000 + "1" + "]" * 5000 + ");"
     with pytest.raises(OpenSCADError, match="nesting deeper|nesting too deep"):
-        read_openscad(vec)
+        read_openscad(vec, facets="true")
     ok = "group() {" * 150 + "cube(size = 1);" + "}" * 150       # deep but allowed
-    assert read_openscad(ok).bounds == ((0.0, 0.0, 0.0), (1.0, 1.0, 1.0))
+    assert read_openscad(ok, facets="true").bounds == ((0.0, 0.0, 0.0), (1.0, 1.0, 1.0))
     with pytest.raises(OpenSCADError, match="holds no geometry"):
-        read_openscad("group();")
+        read_openscad("group();", facets="true")
 
 
 def test_truncated_file(tmp_path):
@@ -203,9 +203,9 @@ def test_truncated_file(tmp_path):
     path = tmp_path / "cut.csg"
     path.write_text(text[: len(text) // 2])
     with pytest.raises(OpenSCADError, match=str(path)):
-        read_openscad(path)
+        read_openscad(path, facets="true")
     with pytest.raises(FileNotFoundError):
-        read_openscad(tmp_path / "missing.csg")
+        read_openscad(tmp_path / "missing.csg", facets="true")
 
 
 @pytest.mark.parametrize("text, bounds", [
@@ -224,4 +224,14 @@ def test_modifiers_as_openscad_writes_them(text, bounds):
 
 def test_a_file_of_background_parts_only_has_no_geometry():
     with pytest.raises(OpenSCADError, match="holds no geometry"):
-        read_openscad("%cube(size = 1);")
+        read_openscad("%cube(size = 1);", facets="true")
+
+
+def test_openscads_facets_are_the_default():
+    # a $fn = 6 cylinder is the hexagonal prism OpenSCAD renders, unless true curves
+    # are asked for
+    text = "cylinder($fn = 6, $fa = 12, $fs = 2, h = 1, r1 = 1, r2 = 1, center = false);"
+    hexagon = np.array(read_openscad(text).bounds)
+    circle = np.array(read_openscad(text, facets="true").bounds)
+    assert np.allclose(hexagon, [[-1, -np.sqrt(3) / 2, 0], [1, np.sqrt(3) / 2, 1]])
+    assert np.allclose(circle, [[-1, -1, 0], [1, 1, 1]])

@@ -9,6 +9,7 @@ import pytest
 from scipy.spatial import Delaunay
 
 import csg
+import implicitvox as iv
 from csg import (Box, Circle, Cylinder, NotAPolytope, Polygon, Polyhedron, Rectangle, Sphere,
                  hull, linear_extrude, minkowski, read_openscad)
 from csg.polytopes import MAX_PIECES, convex_pieces, vertices
@@ -93,8 +94,8 @@ def test_what_is_no_polytope_is_refused_saying_why():
     with pytest.raises(NotAPolytope, match="Sphere is curved") as err:
         hull(Sphere(1), Box((1, 1, 1)))
     assert err.value.curved
-    with pytest.raises(NotAPolytope, match="difference's vertices") as err:
-        hull(Box((2, 2, 2)) - Box((1, 1, 1)))
+    with pytest.raises(NotAPolytope, match="difference in a Minkowski sum") as err:
+        minkowski(Box((2, 2, 2)) - Box((1, 1, 1)), Box((1, 1, 1)))
     assert not err.value.curved
     with pytest.raises(NotAPolytope, match="Cylinder is curved"):
         minkowski(Box((1, 1, 1)), Cylinder(h=1, r=1))
@@ -141,14 +142,27 @@ def test_resize_scales_by_the_facets_bounding_box():
     assert np.allclose(hi - lo, [10, width[1] * 10 / width[0], width[2]])
     with warnings.catch_warnings():
         warnings.simplefilter("error")                # no curved hull here: no warning
-        lo, hi = np.array(read_openscad(text).bounds)
+        lo, hi = np.array(read_openscad(text, facets="true").bounds)
     factor = 10 / width[0]
     assert np.allclose(hi - lo, [4 * factor, 4 * factor, 4])
 
 
-def test_resize_of_a_difference_is_refused_saying_why():
-    text = "resize(newsize = [5, 5, 5]) { difference() { cube(size = 3); " \
-           "sphere(r = 2, $fn = 8); } }"
-    with pytest.raises(csg.OpenSCADError, match="resize: the bounding box.*difference") as err:
-        read_openscad(text, facets="openscad")
-    assert (err.value.line, err.value.column) == (1, 1)
+def test_hull_and_resize_of_a_boolean_take_its_result():
+    # the corner cut off a cube leaves a hull without that corner; a hole inside
+    # does not change the hull
+    cut = hull(Box((2, 2, 2)) - Box((1, 1, 1)).translate((1.5, 1.5, 1.5)))
+    q = np.random.default_rng(0).uniform(-0.2, 2.2, (20000, 3))
+    inside = iv.Function(cut.expr)(*q.T) < 0
+    plane = q.sum(axis=1) - 5.5                   # the hull's cut face: x + y + z = 5.5
+    cube = (np.abs(q - 1) < 1).all(axis=1)
+    clear = (np.abs(plane) > 1e-6) & (np.abs(np.abs(q - 1) - 1).min(axis=1) > 1e-6)
+    assert np.array_equal(inside[clear], (cube & (plane < 0))[clear])
+    inner = hull(Box((2, 2, 2)) - Box((1, 1, 1)).translate((0.5, 0.5, 0.5)))
+    assert inner.bounds == ((0.0, 0.0, 0.0), (2.0, 2.0, 2.0))
+    flat = hull(Rectangle((2, 2)) - Rectangle((1, 1)).translate((1, 1, 0)))
+    assert np.allclose(np.array(flat.bounds)[:, :2], [(0, 0), (2, 2)])
+    assert not (iv.Function(flat.expr)(1.9, 1.9, 0.0) < 0)   # the corner is cut
+    text = "resize(newsize = [6, 6, 6]) { difference() { cube(size = 3); " \
+           "multmatrix([[1, 0, 0, 2], [0, 1, 0, 2], [0, 0, 1, 2], [0, 0, 0, 1]]) cube(size = 2); } }"
+    lo, hi = np.array(read_openscad(text, facets="openscad").bounds)
+    assert np.allclose(lo, 0) and np.allclose(hi, 6)

@@ -12,7 +12,7 @@ import pytest
 from scipy.spatial import cKDTree
 
 from csg import read_openscad
-from csg.openscad_parser import OpenSCADError, OpenSCADWarning
+from csg.openscad_parser import OpenSCADError, OpenSCADWarning, parse
 from csg.text import curve_segments, text_contours, text_polygon, MAX_GLYPHS
 from tests.csg.test_openscad import FIXTURES
 
@@ -59,14 +59,24 @@ def test_bad_options_name_the_parameter():
     with pytest.raises(ValueError, match="MAX_GLYPHS"):
         text_contours("a" * (MAX_GLYPHS + 1))
     with pytest.raises(OpenSCADError, match=r"<csg>:1:28: text: text must be a string"):
-        read_openscad('linear_extrude(height = 1) text(text = 3, size = 10);')
+        read_openscad('linear_extrude(height = 1) text(text = 3, size = 10);', facets="true")
 
 
 def test_blank_text_is_skipped_with_a_warning():
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         solid = read_openscad('linear_extrude(height = 1) text(text = "  ", size = 10); '
-                              'cube(size = [1, 1, 1]);')
+                              'cube(size = [1, 1, 1]);', facets="true")
     assert solid.bounds == ((0.0, 0.0, 0.0), (1.0, 1.0, 1.0))
     assert any(issubclass(w.category, OpenSCADWarning) and ":1:28:" in str(w.message)
                for w in caught)
+
+
+def test_strings_keep_non_ascii_and_decode_openscads_escapes():
+    # OpenSCAD writes "☼" into its .csg as UTF-8: one glyph, not three Latin-1 ones
+    node = parse('text(text = "☼ \\u263C\\x41\\"\\\\", size = 5);')[0]
+    assert node.args["text"] == '☼ ☼A"\\'
+    read = read_openscad('linear_extrude(height = 1) text(text = "☼", size = 50);', facets="true")
+    direct = text_polygon("☼", size=50)
+    lo, hi = np.asarray(read.bounds)
+    assert np.allclose(lo, [*direct.points.min(0), 0]) and np.allclose(hi, [*direct.points.max(0), 1])

@@ -203,7 +203,7 @@ def test_refine_beyond_the_octree_is_refused_at_once():
 def test_polygons_are_bounded():
     pts = ",".join(f"[{i},{(i * 7) % 13}]" for i in range(5000))
     with pytest.raises(OpenSCADError, match="over the limit of 4,000"):
-        read_openscad(f"linear_extrude(height = 1) polygon(points = [{pts}]);")
+        read_openscad(f"linear_extrude(height = 1) polygon(points = [{pts}]);", facets="true")
 
 
 @pytest.mark.parametrize("option", [{"mean_value": "no"}, {"interior": 1}, {"normals": "yes"},

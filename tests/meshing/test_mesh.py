@@ -94,7 +94,7 @@ MODELS = {
     "gear": (lambda: example("gear"), 48),
     "flange (repeat_polar)": (lambda: example("flange"), 32),
     "box-minus-cylinders": (_box_minus_cylinders, 32),
-    "bracket.csg": (lambda: csg.read_openscad(str(FIXTURES / "bracket.csg")), 32),
+    "bracket.csg": (lambda: csg.read_openscad(str(FIXTURES / "bracket.csg"), facets="true"), 32),
 }
 
 

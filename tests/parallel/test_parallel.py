@@ -122,7 +122,7 @@ def test_meshes_and_patches_give_the_serial_voxels():
 
 
 def test_openscad_model_in_parallel():
-    solid = csg.read_openscad(os.path.join(FIXTURES, "bracket.csg"))
+    solid = csg.read_openscad(os.path.join(FIXTURES, "bracket.csg"), facets="true")
     serial = iv.voxelize(solid, 48, interior=True, workers=1)
     assert digest(iv.voxelize(solid, 48, interior=True, workers=2)) == digest(serial)
 

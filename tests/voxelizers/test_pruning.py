@@ -66,7 +66,7 @@ def test_options(name, options):
 
 @pytest.mark.parametrize("model", sorted(p.stem for p in FIXTURES.glob("*.csg")))
 def test_openscad_fixtures(model):
-    _both(read_openscad(FIXTURES / f"{model}.csg"), interior=True, normals=True)
+    _both(read_openscad(FIXTURES / f"{model}.csg", facets="true"), interior=True, normals=True)
 
 
 @pytest.mark.parametrize("shape", [menger(2), sphere_union(40), drilled_plate(6, 6)],
