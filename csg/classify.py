@@ -46,11 +46,14 @@ from implicitvox.triangles.tribox import Triangles
 from implicitvox.octree.morton import CORNERS
 
 __all__ = ["plan", "exact_classifier", "world_primitive", "similarity_scale", "MeshClassifier",
-           "SETTLE_DEPTH"]
+           "SETTLE_DEPTH", "SUPPORT_PAD"]
 
 #: internal states: two or more exact children AMBIGUOUS (settled by subdivision), and
 #: an interval (not exact) AMBIGUOUS, which stays AMBIGUOUS through the booleans
 UNKNOWN, MAYBE = 3, 4
+#: relative outward padding of a leaf's bounding box, off which its state is taken
+#: without its test (far beyond the rounding its tests allow for)
+SUPPORT_PAD = 1e-9
 #: halvings of a box whose state is unknown before it counts as AMBIGUOUS
 SETTLE_DEPTH = 2
 #: unknown boxes settled at once (each may have up to 4**SETTLE_DEPTH sub-boxes in play)
@@ -144,12 +147,59 @@ def _plan(solid, matrix: np.ndarray) -> tuple:
         return _function(solid, matrix)
     kids = [_plan(c, matrix) for c in solid.children]
     if solid.operation == "union":
-        return ("union", kids)
+        return _boolean("union", kids)
     if solid.operation == "intersection":
-        return ("intersection", kids)
+        return _boolean("intersection", kids)
     if solid.operation == "difference":
-        return ("intersection", [kids[0]] + [("complement", k) for k in kids[1:]])
+        return _boolean("intersection", [kids[0]] + [("complement", k) for k in kids[1:]])
     return ("complement", kids[0])
+
+
+def _boolean(kind: str, kids: list) -> tuple:
+    """A union or intersection node: its children and their supports (stacked:
+    ``lo`` (k, 3), ``hi`` (k, 3), the state off the box (k,)), so that a box
+    evaluates only the children whose support box it touches."""
+    supports = [_support(k) for k in kids]
+    lo = np.array([sp[0] for sp in supports], dtype=np.float64).reshape(-1, 3)
+    hi = np.array([sp[1] for sp in supports], dtype=np.float64).reshape(-1, 3)
+    return (kind, kids, (lo, hi, np.array([sp[2] for sp in supports], dtype=np.int8)))
+
+
+def _support(node: tuple) -> tuple[np.ndarray, np.ndarray, int]:
+    """A box ``[lo, hi]`` off which the node's state is the same everywhere, and
+    that state: EMPTY off a leaf's bounding box; a complement swaps it. Unbounded
+    (infinite) where nothing is known: a function (its interval decides, even off
+    its solid), a half-space. Padded outward (:data:`SUPPORT_PAD`) beyond every
+    rounding of the leaves' tests, so culling a child changes no state."""
+    everywhere = (np.full(3, -np.inf), np.full(3, np.inf), EMPTY)
+    kind = node[0]
+    if kind == "mesh":
+        lo, hi = node[1].lo, node[1].hi
+    elif kind == "exact":
+        bounds = getattr(node[1], "bounds", None)
+        if bounds is None:
+            return everywhere
+        lo, hi = np.asarray(bounds[0], dtype=np.float64), np.asarray(bounds[1], dtype=np.float64)
+    elif kind == "complement":
+        lo, hi, off = _support(node[1])
+        return lo, hi, (FULL if off == EMPTY else EMPTY)
+    elif kind in ("union", "intersection"):
+        klo, khi, koff = node[2]
+        absorbing = FULL if kind == "union" else EMPTY
+        # children absorbing off their boxes: an intersection lies in each such
+        # child, so in their boxes' intersection, and is EMPTY off it; dually a
+        # union's complement (De Morgan). Else every child is neutral off its box,
+        # and so is the node off their hull.
+        pick = koff == absorbing
+        if pick.any():
+            return klo[pick].max(axis=0), khi[pick].min(axis=0), absorbing
+        return klo.min(axis=0), khi.max(axis=0), (EMPTY if kind == "union" else FULL)
+    else:
+        return everywhere
+    if not (np.all(np.isfinite(lo)) and np.all(np.isfinite(hi))):
+        return everywhere
+    pad = SUPPORT_PAD * (np.abs(lo).max() + np.abs(hi).max() + (hi - lo).max())
+    return lo - pad, hi + pad, EMPTY
 
 
 def _run(plan: tuple, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
@@ -167,7 +217,15 @@ def _run(plan: tuple, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
     if kind == "complement":
         s = _run(plan[1], lo, hi)
         return np.where(s == FULL, EMPTY, np.where(s == EMPTY, FULL, s)).astype(np.int8)
-    states = np.array([_run(k, lo, hi) for k in plan[1]])
+    klo, khi, koff = plan[2]
+    touches = np.all((lo[None] <= khi[:, None]) & (hi[None] >= klo[:, None]), axis=2)
+    states = np.repeat(koff[:, None], len(lo), axis=1)
+    for k, kid in enumerate(plan[1]):        # each child only where its support reaches
+        if touches[k].all():
+            states[k] = _run(kid, lo, hi)
+        elif touches[k].any():
+            near = np.flatnonzero(touches[k])
+            states[k, near] = _run(kid, lo[near], hi[near])
     # a union is an intersection of complements: one rule, with the roles swapped
     absorbing, neutral = (FULL, EMPTY) if kind == "union" else (EMPTY, FULL)
     out = np.full(len(lo), UNKNOWN, dtype=np.int8)

@@ -319,3 +319,36 @@ def test_settling_drops_voxels_where_two_surfaces_cancel():
     pts = lo[:, None, :] + offsets[None] * np.array(g.voxel_size)
     dist = np.linalg.norm(pts[:, :, None, :] - centres[None, None], axis=-1) - radii
     assert np.all(dist.min(axis=2) < 0)                 # every sample inside a ball
+
+
+def _unculled(node):
+    """The same plan with every child's support unbounded: each child tested on every box."""
+    if node[0] in ("union", "intersection"):
+        kids = [_unculled(k) for k in node[1]]
+        n = len(kids)
+        return (node[0], kids, (np.full((n, 3), -np.inf), np.full((n, 3), np.inf), node[2][2]))
+    if node[0] == "complement":
+        return ("complement", _unculled(node[1]))
+    return node
+
+
+def test_culling_children_by_their_support_changes_no_state():
+    from csg.classify import exact_classifier, plan
+    rng = np.random.default_rng(11)
+    for _ in range(12):
+        parts = []
+        for _ in range(rng.integers(2, 10)):
+            kind = rng.integers(0, 3)
+            p = Box(tuple(rng.choice([0.25, 0.5, 0.75], 3)), center=bool(rng.integers(0, 2))) \
+                if kind == 0 else Sphere(float(rng.choice([0.2, 0.4]))) if kind == 1 else \
+                Cylinder(h=0.8, r=0.25).rotate("x", 90)
+            parts.append(p.translate(tuple(np.round(rng.uniform(-0.6, 0.6, 3) * 8) / 8)))
+        tree = parts[0]
+        for p in parts[1:]:
+            tree = [tree | p, tree & p, tree - p][rng.integers(0, 3)]
+        whole = plan(tree)
+        # boxes of several sizes, on a 1/16 lattice (faces of the parts lie on it: ties)
+        lo = np.round(rng.uniform(-1, 1, (3000, 3)) * 16) / 16
+        hi = lo + rng.choice([1 / 16, 1 / 8, 1 / 2], (3000, 1))
+        culled = exact_classifier(whole, settle=True)(lo, hi)
+        assert np.array_equal(culled, exact_classifier(_unculled(whole), settle=True)(lo, hi))
