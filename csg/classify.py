@@ -14,6 +14,9 @@ leaf classifies boxes as EMPTY, FULL or AMBIGUOUS:
   similarities that keep their axis along x, y or z) by their max-norm
   distance (Varadhan §5.1, :mod:`implicitvox.linf`): AMBIGUOUS iff the
   surface meets the box (up to rounding at exact ties);
+* a straight prism (:class:`csg.prism.Prism`, OpenSCAD's extrusion of a 2D
+  region) exactly, by its outlines' edges (:class:`csg.prism.PrismClassifier`)
+  or its mesh;
 * a function by its interval enclosure (sound; AMBIGUOUS may be a near miss).
 
 The booleans combine the states: a union is FULL if a child is, EMPTY if all
@@ -21,14 +24,17 @@ are, AMBIGUOUS if exactly one child is and the others are EMPTY (the union's
 surface in the box is that child's); an intersection dually; a complement
 swaps FULL and EMPTY. Where two children are AMBIGUOUS the state is
 *unknown* - the surfaces may cancel inside the box - and the box is settled
-by subdivision (:func:`_settle`): its surface is met iff a sub-box is
+by subdivision (:func:`_settle`; at the voxel level, so is an interval
+leaf's AMBIGUOUS, as the voxelizer rechecks a voxel with no exact test on its
+sub-voxels): its surface is met iff a sub-box is
 AMBIGUOUS by the rules above, or one sub-box is FULL and another EMPTY (the
 box is connected); EMPTY or FULL iff every sub-box is. A box still unknown
 after :data:`SETTLE_DEPTH` halvings (two surfaces touching at a tangency)
 counts as AMBIGUOUS: conservative, never a missed voxel. So a union,
 intersection or difference of exact leaves voxelizes exactly, ties aside.
 An interval leaf's AMBIGUOUS is not exact (it may be a near miss): combined
-with another AMBIGUOUS child it stays AMBIGUOUS, without subdivision.
+with another AMBIGUOUS child it stays AMBIGUOUS, and a sub-box that is such
+counts as met (never a missed voxel).
 """
 from __future__ import annotations
 
@@ -107,7 +113,10 @@ def exact_classifier(tree_plan: Optional[tuple], settle: bool = False
     def classify(lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
         lo, hi = np.asarray(lo, dtype=float), np.asarray(hi, dtype=float)
         state = _run(tree_plan, lo, hi)
-        unknown = np.flatnonzero(state == UNKNOWN) if settle else np.zeros(0, dtype=np.int64)
+        # at the voxel level an interval leaf's AMBIGUOUS (perhaps a near miss) is
+        # halved too, as the voxelizer rechecks voxels with no exact test
+        unsure = (state == UNKNOWN) | (state == MAYBE)
+        unknown = np.flatnonzero(unsure) if settle else np.zeros(0, dtype=np.int64)
         for start in range(0, len(unknown), SETTLE_CHUNK):
             part = unknown[start:start + SETTLE_CHUNK]
             state[part] = _settle(tree_plan, lo[part], hi[part])
@@ -173,7 +182,7 @@ def _support(node: tuple) -> tuple[np.ndarray, np.ndarray, int]:
     rounding of the leaves' tests, so culling a child changes no state."""
     everywhere = (np.full(3, -np.inf), np.full(3, np.inf), EMPTY)
     kind = node[0]
-    if kind == "mesh":
+    if kind in ("mesh", "prism"):
         lo, hi = node[1].lo, node[1].hi
     elif kind == "exact":
         bounds = getattr(node[1], "bounds", None)
@@ -210,7 +219,7 @@ def _run(plan: tuple, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
         state[flo > 0] = EMPTY
         state[fhi < 0] = FULL
         return state
-    if kind == "mesh":
+    if kind in ("mesh", "prism"):
         return plan[1].classify(lo, hi)
     if kind == "exact":
         return plan[1].classify_boxes(lo, hi)

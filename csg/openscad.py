@@ -62,6 +62,7 @@ import numpy as np
 from . import facets as fx
 from .clipper2d import NotFlat, offset as clipped_offset, region_pieces
 from .dxf import read_dxf
+from .prism import Prism
 from .projection import NotAMesh, projection as project
 from .text import text_polygon
 from .heightmap import heightmap_mesh
@@ -474,17 +475,22 @@ class _Builder:
         scale = self.vector(node, "scale", 2, 1.0)
         center = self.flag(node, "center")
         straight = twist == 0 and scale[0] == scale[1]
-        if not _holds_text(node) and (not self.faceted or straight):
-            return LinearExtrude(body, h, twist, scale, center)
-        # OpenSCAD's glyph outlines are long non-convex polygons whose function
-        # encloses loosely over a box: their extrusion is taken as its mesh, as below
-        # OpenSCAD extrudes the result of its 2D booleans (Clipper): so does this
+        # OpenSCAD extrudes the result of its 2D booleans (Clipper): so does this. A
+        # straight one is a Prism (an exact box test: a polygon's function encloses
+        # loosely near concave corners, a glyph's most of all); true circles
+        # (facets="true") keep their function
         try:
             pieces = region_pieces(body)
         except NotFlat as err:
+            if not self.faceted:
+                return LinearExtrude(body, h, twist, scale, center)
             raise self.error(node, f"linear_extrude: {err}") from None
         if not pieces:
             return self.skip(node, "its 2D children leave no area")
+        if twist == 0 and scale[0] == scale[1] == 1:
+            return Prism(pieces, h, center)
+        if not _holds_text(node) and (not self.faceted or straight):
+            return LinearExtrude(body, h, twist, scale, center)
         if straight:
             slices = 1.0
         elif node.args.get("slices") is not None:

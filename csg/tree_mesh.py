@@ -11,7 +11,8 @@ operands: the shadow of a difference or intersection (:mod:`csg.projection`).
 
 Leaves: :class:`~csg.primitives.Polyhedron` (imported meshes, ``surface``,
 polyhedra), :class:`~csg.primitives.ConvexPolyhedron` given by points (OpenSCAD's
-faceted spheres and cylinders), :class:`~csg.primitives.Box`, moved by any
+faceted spheres and cylinders), :class:`~csg.primitives.Box`,
+:class:`~csg.prism.Prism` (OpenSCAD's straight extrusions), moved by any
 ``multmatrix``. Meshes come out oriented outward.
 
 Examples
@@ -27,6 +28,7 @@ import numpy as np
 
 from .primitives import (Box, ConvexPolyhedron, Cylinder, Ellipsoid, Polyhedron, Sphere,
                          Torus)
+from .prism import Prism
 from .solid import Difference, Intersection, Solid, Transformed, Union
 
 __all__ = ["tree_mesh", "leaf_mesh", "mesh_volume", "NotAMesh"]
@@ -75,6 +77,8 @@ def leaf_mesh(solid: Solid, matrix: np.ndarray) -> tuple[np.ndarray, np.ndarray]
                        "(facet it first: read_openscad(..., facets='openscad'))", curved=True)
     if isinstance(solid, Polyhedron):
         v, f = solid.vertices, np.asarray(solid.faces)
+    elif isinstance(solid, Prism):
+        v, f = solid.mesh()
     elif isinstance(solid, ConvexPolyhedron) and solid.points is not None:
         v, f = _hull_mesh(np.asarray(solid.points, dtype=np.float64))
     elif isinstance(solid, Box):

@@ -15,8 +15,10 @@ For every ``/usr/share/openscad/examples/**/*.scad``:
 3. The STL is voxelized exactly (``voxelize_mesh``) at ``--resolution`` over its
    bounds, and the solid on the same lattice (``workers=1``: CPU time against
    OpenSCAD's, one core each). With OpenSCAD's facets every STL voxel must be
-   in the output (``missed``; the STL's vertices are rounded to 6 digits, so a
-   voxel the STL only grazes within that rounding may count); an independent
+   in the output (``missed``); the STL's vertices are rounded to 6 digits, so a
+   missed voxel that the STL enters by no more than that rounding (the largest
+   inset of the voxel a triangle still meets, against 5e-6 of the triangle's
+   largest coordinate: :func:`stl_depths`) is counted apart; an independent
    check samples 20,000 points on the STL's triangles and counts those no output
    voxel holds. With true curves, ``far`` counts STL voxels with no output voxel
    within one voxel. ``ratio`` is output voxels over STL voxels.
@@ -80,6 +82,44 @@ def _export(scad: Path, timeout: float) -> dict:
     return info
 
 
+#: OpenSCAD 2021.01 writes STL coordinates with 6 significant digits: each is off by up to
+#: half a unit in its 6th digit, 5e-6 of its magnitude
+STL_ROUNDING = 5e-6
+#: missed voxels examined one by one for how deep the STL enters them (more: all count)
+EXAMINED = 200
+
+
+def stl_depths(stl, triangles, missed: np.ndarray) -> np.ndarray:
+    """For each missed voxel (its lattice coordinates), how far into it the STL reaches
+    (the largest inset of the voxel box that a triangle still meets, by bisection)
+    over that triangle's rounding (STL_ROUNDING of its largest coordinate): at most 1
+    means the STL enters the voxel only within its own 6-digit rounding."""
+    from implicitvox.triangles.tribox import Triangles
+    h = np.asarray(stl.voxel_size)
+    out = np.full(len(missed), np.inf)
+    for i, m in enumerate(missed[:EXAMINED]):
+        lo = np.array([stl.grid.edge(a, m[a]) for a in range(3)])
+        hi = lo + h
+        near = np.flatnonzero(np.all((triangles.min(axis=1) <= hi) &
+                                     (triangles.max(axis=1) >= lo), axis=1))
+        tris = Triangles(triangles[near])
+        ids = np.arange(len(near))
+
+        def meets(inset: float) -> np.ndarray:
+            return tris.meet_boxes(ids, np.repeat((lo + inset)[None], len(ids), 0),
+                                   np.repeat((hi - inset)[None], len(ids), 0))
+        hit = meets(0.0)
+        if not hit.any():
+            continue
+        a, b = 0.0, 0.5 * h.min()
+        for _ in range(48):
+            mid = 0.5 * (a + b)
+            a, b = (mid, b) if meets(mid)[hit].any() else (a, mid)
+        scale = np.abs(triangles[near[hit]]).max()
+        out[i] = a / (STL_ROUNDING * scale)
+    return out
+
+
 def child(csg_path: str, stl_path: str, res: int, base: str) -> dict:
     """In a child process: read, voxelize both ways, compare (see the module docstring)."""
     import warnings
@@ -110,6 +150,9 @@ def child(csg_path: str, stl_path: str, res: int, base: str) -> dict:
         held = vox.contains(stl.coords())
         row = {"cpu": cpu, "voxels": vox.count, "ratio": vox.count / max(stl.count, 1),
                "missed": int((~held).sum()), "points_out": misses(vox, points)}
+        if mode == "openscad":
+            depth = stl_depths(stl, v[f], stl.coords()[~held])
+            row["grazed"] = int((depth <= 1).sum())          # within the STL's rounding
         if mode == "true":
             c = stl.coords()[~held].astype(np.int64)
             near = np.zeros(len(c), dtype=bool)
@@ -179,15 +222,18 @@ def main() -> None:
                 summary["read"] += 1
                 summary["ratios"].append(o["ratio"])
                 summary["times"].append(o["cpu"] / max(scad_cpu, 1e-3))
-                if o["missed"] == 0 and o["points_out"] == 0:
+                if o["missed"] == o.get("grazed", 0) and o["points_out"] == 0:
                     summary["clean"] += 1
-        rows.append([name, status, _cell(o, "missed"), _cell(o, "points_out"),
+        missed = _cell(o, "missed") if not o.get("grazed") else \
+            f"{o['missed'] - o['grazed']} (+{o['grazed']} within the STL's rounding)"
+        rows.append([name, status, missed, _cell(o, "points_out"),
                      _cell(o, "ratio", "{:.3f}"), _cell(o, "cpu", "{:.2f}"), f"{scad_cpu:.2f}",
                      _cell(t, "far"), _cell(t, "ratio", "{:.3f}"), _cell(t, "cpu", "{:.2f}")])
         print(" | ".join(rows[-1]), flush=True)
     ratios, times = np.array(summary["ratios"]), np.array(summary["times"])
     line = (f"{summary['models']} models, {summary['3d']} with a 3D result, {summary['read']} "
-            f"read, {summary['clean']} with no STL voxel or point missed (facets='openscad')")
+            f"read, {summary['clean']} with no STL voxel or point missed (facets='openscad'; "
+            "voxels the STL enters only within its 6-digit rounding aside)")
     if len(ratios):
         line += (f"; voxel ratio median {np.median(ratios):.3f}, worst {ratios.max():.3f}; CPU "
                  f"against OpenSCAD's STL export median {np.median(times):.2f}x, worst "
