@@ -39,7 +39,7 @@ from .clipper2d import CLIPPER_SCALE, NotFlat, region_paths
 from .planar import Circle, LinearExtrude, Polygon, Rectangle
 from .primitives import Box, ConvexPolyhedron, Cylinder, Ellipsoid, Polyhedron, Sphere, Torus
 from .solid import Solid, Transformed, Union
-from .tree_mesh import NotAMesh, tree_mesh
+from .tree_mesh import NotAMesh, mesh_volume, tree_mesh
 
 __all__ = ["hull", "minkowski", "vertices", "convex_pieces", "convex_solid", "NotAPolytope",
            "MAX_PLANES", "MAX_PIECES", "MAX_SUMS"]
@@ -195,8 +195,7 @@ def _is_convex_polygon(poly: np.ndarray) -> bool:
 def _is_convex(v: np.ndarray, f: np.ndarray) -> bool:
     """Whether a closed mesh is convex: its volume equals its hull's."""
     from scipy.spatial import ConvexHull, QhullError
-    a, b, c = v[f[:, 0]], v[f[:, 1]], v[f[:, 2]]
-    volume = abs(float(np.einsum("ij,ij->i", a, np.cross(b, c)).sum()) / 6)
+    volume = abs(mesh_volume(v, f))
     try:
         whole = ConvexHull(v[np.unique(f.ravel())]).volume
     except QhullError:

@@ -74,7 +74,8 @@ def linf_by_box_test(classify: Callable, points: np.ndarray, weights: Any,
                      limit: float = np.inf) -> tuple[np.ndarray, np.ndarray]:
     """Signed weighted max-norm distances from an exact box test, by bisection on the
     bit patterns of the cube's half-size (64 steps at most); error one ulp of the
-    distance plus the box test's allowance for rounding (``linf.classify.TIE_ULPS``). ``limit`` caps the search (points farther get ``±limit``)."""
+    distance plus the box test's allowance for rounding (``linf.classify.TIE_ULPS``).
+    ``limit`` caps the search (points farther get ``±limit``)."""
     p = np.asarray(points, dtype=np.float64)
     n = len(p)
     w = np.ones((n, 3)) if weights is None else \
