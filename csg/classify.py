@@ -47,7 +47,7 @@ from implicitvox import batches
 from implicitvox.expr.shape import AMBIGUOUS, EMPTY, FULL
 from implicitvox.triangles.crossings import RayWinding
 from implicitvox.triangles.pairs import sorted_unique
-from implicitvox.triangles.ranges import buckets, expand_boxes, gather
+from implicitvox.triangles.ranges import buckets, expand_boxes, gather, grid_cells
 from implicitvox.triangles.tribox import Triangles
 from implicitvox.octree.morton import CORNERS
 
@@ -301,8 +301,9 @@ class MeshClassifier:
         self.lo = self.tris.lo.min(axis=0)
         self.hi = self.tris.hi.max(axis=0)
         n = len(self.tris)
-        self.cells = int(np.clip(round(2 * n ** (1 / 3)), 1, 64))
         span = np.where(self.hi > self.lo, self.hi - self.lo, 1.0)
+        self.cells = grid_cells(self.tris.lo, self.tris.hi, self.lo, span,
+                                int(np.clip(round(2 * n ** (1 / 3)), 1, 64)))
         self.cell_size = span / self.cells
         first = self._cell(self.tris.lo)
         last = self._cell(self.tris.hi)

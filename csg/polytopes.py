@@ -226,7 +226,7 @@ def convex_solid(points: Any) -> Solid:
                          f"{str(err).splitlines()[0]}") from None
     if pts.shape[1] == 2:
         return Polygon(pts[hull.vertices])           # counter-clockwise in 2D
-    if len(hull.equations) <= MAX_PLANES:
+    if len(np.unique(hull.equations, axis=0)) <= MAX_PLANES:   # a facet's triangles share one
         return ConvexPolyhedron(points=pts)
     faces = hull.simplices.copy()
     # orient every triangle outward: its normal along the hull's facet normal

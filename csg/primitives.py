@@ -307,14 +307,12 @@ class ConvexPolyhedron(Solid):
             if pts.ndim != 2 or pts.shape[1] != 3 or len(pts) < 4 or \
                     not np.all(np.isfinite(pts)):
                 raise ValueError("points must be an (n, 3) array of at least 4 finite points")
-            from scipy.spatial import ConvexHull, QhullError
             try:
-                hull = ConvexHull(pts)
-            except QhullError as err:
+                faces = linf.convex_hull_faces(pts)
+            except ValueError as err:
                 raise ValueError(f"the points span no volume (flat or degenerate): "
-                                 f"{str(err).splitlines()[0]}") from None
-            normals, offsets = hull.equations[:, :3], -hull.equations[:, 3]
-            self.points = pts[hull.vertices]
+                                 f"{str(err).split(': ', 1)[-1]}") from None
+            normals, offsets, self.points = faces.normals, faces.offsets, faces.vertices
         else:
             normals = np.asarray(planes[0], dtype=np.float64)
             offsets = np.asarray(planes[1], dtype=np.float64)

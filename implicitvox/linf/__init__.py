@@ -37,7 +37,7 @@ import numpy as np
 
 from .classify import Primitive, classify_by_distance
 from .mesh import TriangleMesh
-from .polyhedron import ConvexPolyhedron, HalfSpace, triangle_distance
+from .polyhedron import ConvexPolyhedron, HalfSpace, convex_hull_faces, triangle_distance
 from .sphere import Sphere
 from .ellipsoid import Ellipsoid
 from .cylinder import Cylinder, Frustum
@@ -46,7 +46,7 @@ from .quadric import Quadric
 
 __all__ = ["linf_distance", "HalfSpace", "ConvexPolyhedron", "Sphere", "Ellipsoid", "Cylinder", "Frustum",
            "Torus", "Quadric", "TriangleMesh",
-           "triangle_distance", "classify_by_distance", "Primitive"]
+           "triangle_distance", "convex_hull_faces", "classify_by_distance", "Primitive"]
 
 
 def linf_distance(shape: Any, points: Any, weights: Any = None) -> np.ndarray:

@@ -18,7 +18,12 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["expand", "expand_boxes", "gather", "buckets"]
+__all__ = ["expand", "expand_boxes", "gather", "buckets", "grid_cells", "ENTRIES_PER_ITEM"]
+
+#: a bucket grid over ``n`` items holds at most about this many (cell, item) entries per
+#: item (and at least 2**20 in all): long, thin items spanning many cells coarsen the grid
+#: instead of filling memory
+ENTRIES_PER_ITEM = 64
 
 
 def expand(counts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -40,6 +45,28 @@ def expand_boxes(first: np.ndarray, last: np.ndarray) -> tuple[np.ndarray, np.nd
         cols.append(k % e[:, a])
         k = k // e[:, a]
     return owner, first[owner] + np.stack(cols[::-1], axis=1)
+
+
+def grid_cells(lo: np.ndarray, hi: np.ndarray, span_lo: np.ndarray, span: np.ndarray,
+               cells: int) -> int:
+    """The cells per axis (at most ``cells``) of a uniform grid over ``span_lo + [0, span]``
+    such that the items' boxes ``lo .. hi`` ``(n, d)`` cover at most
+    ``max(ENTRIES_PER_ITEM * n, 2**20)`` cells in all: halved until they do.
+
+    >>> import numpy as np
+    >>> lo, hi = np.zeros((10, 2)), np.ones((10, 2))     # ten boxes over the whole span
+    >>> grid_cells(lo, hi, np.zeros(2), np.ones(2), 1024)
+    256
+    """
+    limit = max(ENTRIES_PER_ITEM * len(lo), 1 << 20)
+    while cells > 1:
+        size = span / cells
+        first = np.clip(np.floor((lo - span_lo) / size), 0, cells - 1)
+        last = np.clip(np.floor((hi - span_lo) / size), 0, cells - 1)
+        if np.prod(last - first + 1, axis=1).sum() <= limit:
+            break
+        cells //= 2
+    return max(int(cells), 1)
 
 
 def gather(starts: np.ndarray, counts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

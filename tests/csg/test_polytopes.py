@@ -166,3 +166,26 @@ def test_hull_and_resize_of_a_boolean_take_its_result():
            "multmatrix([[1, 0, 0, 2], [0, 1, 0, 2], [0, 0, 1, 2], [0, 0, 0, 1]]) cube(size = 2); } }"
     lo, hi = np.array(read_openscad(text, facets="openscad").bounds)
     assert np.allclose(lo, 0) and np.allclose(hi, 6)
+
+
+def test_a_faceted_cone_is_a_convex_polyhedron_of_its_facets_planes():
+    """Qhull's triangles of one facet share its plane: OpenSCAD's 30-gon frustum is a
+    ConvexPolyhedron of 32 planes (not 116 triangle planes, nor a mesh), and its
+    exact test gives the very voxels and interior of the mesh test on its triangles."""
+    from scipy.spatial import ConvexHull
+    from csg import facets
+    from csg.polytopes import convex_solid
+    pts = facets.cylinder_points(20.0, 5.0, -25.0, 25.0, 30)
+    cone = convex_solid(pts)
+    assert isinstance(cone, csg.ConvexPolyhedron) and len(cone.normals) == 32
+    h = ConvexHull(pts)
+    faces = h.simplices.copy()
+    v = pts[faces]
+    flip = np.einsum("ij,ij->i", np.cross(v[:, 1] - v[:, 0], v[:, 2] - v[:, 0]),
+                     h.equations[:, :3]) < 0
+    faces[flip] = faces[flip][:, ::-1]
+    mesh = Polyhedron(pts, faces)
+    bounds = ((-21, -21, -26), (21, 21, 26))
+    a, b = _voxels(cone, bounds, 48), _voxels(mesh, bounds, 48)
+    from tests.golden.digests import voxel_digests
+    assert a.count > 0 and voxel_digests(a) == voxel_digests(b)

@@ -55,7 +55,7 @@ def _digest(*arrays) -> str:
     return h.hexdigest()[:24]
 
 
-def _voxel_digests(vox) -> dict[str, str]:
+def voxel_digests(vox) -> dict[str, str]:
     out = {"count": str(vox.count), "voxels": _digest(vox.coords())}
     if vox.interior:
         out["interior"] = _digest(*[np.asarray(lvl) for lvl in sorted(vox.interior)],
@@ -94,7 +94,7 @@ def _examples(out: dict) -> None:
         for res in (64, 128):
             for label, opts in OPTIONS.items():
                 vox = iv.voxelize(shape.expr, bounds=bounds, resolution=res, **opts)
-                for k, v in _voxel_digests(vox).items():
+                for k, v in voxel_digests(vox).items():
                     out[f"voxelize/{name}/{res}/{label}/{k}"] = v
 
 
@@ -140,13 +140,13 @@ def _openscad(out: dict) -> None:
             solid = read_openscad(path, facets=facets)
             bounds = _cube(solid.bounds, 1.04)
             vox = iv.voxelize(solid, bounds=bounds, resolution=64, interior=True)
-            for k, v in _voxel_digests(vox).items():
+            for k, v in voxel_digests(vox).items():
                 out[f"openscad/{path.stem}/{facets}/64/{k}"] = v
         stl = path.with_suffix(".stl")
         for res in (64, 128):
             vox = iv.voxelize_mesh(str(stl), bounds=_cube(iv_mesh_bounds(stl), 1.04),
                                    resolution=res, interior=True)
-            for k, v in _voxel_digests(vox).items():
+            for k, v in voxel_digests(vox).items():
                 out[f"mesh/{stl.stem}/{res}/{k}"] = v
 
 
@@ -163,13 +163,13 @@ def _teapot_and_torus(out: dict) -> None:
         teapot = iv.utah_teapot()
         vox = iv.voxelize_bezier(teapot, bounds=((-3.5, -3.5, -0.5), (3.5, 3.5, 6.5)),
                                  resolution=res)
-        for k, v in _voxel_digests(vox).items():
+        for k, v in voxel_digests(vox).items():
             out[f"bezier/teapot/{res}/{k}"] = v
     tilted = Torus(1.0, 0.3).rotate((1, 2, 0.5), 35).translate((0.05, -0.02, 0.03))
     for res in (64, 128):
         vox = iv.voxelize(tilted, bounds=((-1.5,) * 3, (1.5,) * 3), resolution=res,
                           interior=True)
-        for k, v in _voxel_digests(vox).items():
+        for k, v in voxel_digests(vox).items():
             out[f"csg/tilted-torus/{res}/{k}"] = v
 
 

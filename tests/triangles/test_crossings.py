@@ -1,0 +1,50 @@
+"""Exact ray-crossing winding numbers: the bucket grid changes nothing, and stays small."""
+import numpy as np
+import pyvista as pv
+
+from implicitvox.triangles import crossings
+from implicitvox.triangles.crossings import RayWinding
+from implicitvox.triangles.inputs import as_triangles
+from implicitvox.triangles.ranges import ENTRIES_PER_ITEM
+
+
+def _one_cell(monkeypatch, tris: np.ndarray) -> RayWinding:
+    """The same winding numbers with every triangle in one cell (no grid at all)."""
+    with monkeypatch.context() as m:
+        m.setattr(crossings, "CELLS_PER_ROOT", 1e-9)
+        plain = RayWinding(tris)
+    assert plain.cells == 1
+    return plain
+
+
+def test_points_on_cell_and_shadow_edges_find_their_triangles(monkeypatch):
+    # no slack around a shadow's cells: a point on the edge of a shadow's box (a
+    # vertex's y or z) or on a cell boundary must still meet the shadow's triangles
+    v, f = as_triangles(pv.Sphere(radius=1.0, theta_resolution=17, phi_resolution=13))
+    tris = v[f]
+    grid = RayWinding(tris)
+    assert grid.cells > 4
+    rng = np.random.default_rng(5)
+    corners = tris.reshape(-1, 3)
+    p = rng.uniform(-1.2, 1.2, (6000, 3))
+    p[:2000, 1] = corners[rng.integers(len(corners), size=2000), 1]
+    p[2000:4000, 2] = corners[rng.integers(len(corners), size=2000), 2]
+    k = rng.integers(0, grid.cells + 1, size=(2000, 2))
+    p[4000:, 1:] = grid.lo2 + k * grid.size                  # cell boundaries
+    expected = _one_cell(monkeypatch, tris)(p)
+    assert np.array_equal(grid(p), expected)
+    assert set(np.unique(expected)) == {0, 1}                # both sides are tested
+
+
+def test_long_thin_triangles_coarsen_the_grid_instead_of_filling_memory(monkeypatch):
+    # 1,000 slivers whose shadows' boxes each cover the whole yz square: a grid of
+    # 2 sqrt(n) cells a side would hold 4 million (cell, triangle) entries
+    n = 1000
+    t = np.linspace(0.0, 1.0, n)
+    tris = np.stack([np.stack([t, np.zeros(n), np.zeros(n)], 1),
+                     np.stack([t, np.ones(n), np.ones(n)], 1),
+                     np.stack([t + 1e-3, np.ones(n), np.full(n, 1.001)], 1)], axis=1)
+    grid = RayWinding(tris)
+    assert len(grid.cell_tris) <= max(ENTRIES_PER_ITEM * n, 1 << 20)
+    p = np.random.default_rng(2).uniform(-0.1, 1.1, (1500, 3))
+    assert np.array_equal(grid(p), _one_cell(monkeypatch, tris)(p))
