@@ -117,6 +117,10 @@ def exact_classifier(tree_plan: Optional[tuple], settle: bool = False
         # halved too, as the voxelizer rechecks voxels with no exact test
         unsure = (state == UNKNOWN) | (state == MAYBE)
         unknown = np.flatnonzero(unsure) if settle else np.zeros(0, dtype=np.int64)
+        if len(unknown):
+            seen = _witnessed(tree_plan, lo[unknown], hi[unknown])
+            state[unknown[seen]] = AMBIGUOUS
+            unknown = unknown[~seen]
         for start in range(0, len(unknown), SETTLE_CHUNK):
             part = unknown[start:start + SETTLE_CHUNK]
             state[part] = _settle(tree_plan, lo[part], hi[part])
@@ -247,6 +251,19 @@ def _run(plan: tuple, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
     out[n_active == 0] = neutral
     out[(states == absorbing).any(axis=0)] = absorbing
     return out
+
+
+def _witnessed(plan: tuple, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+    """Which boxes hold a point inside the solid and a point outside it, among
+    their corners and centres: a box is connected, so such a box meets the
+    surface (AMBIGUOUS, as :func:`_settle` would find it, at a ninth of the
+    cost of its first halving). A point is classified as the degenerate box
+    ``[p, p]``, by the same exact tests: FULL or EMPTY only off every surface."""
+    mid = 0.5 * (lo + hi)                                   # rounded, but inside the box
+    points = np.concatenate([np.where(_HALF[None], hi[:, None], lo[:, None]),
+                             mid[:, None]], axis=1).reshape(-1, 3)
+    s = _run(plan, points, points).reshape(len(lo), 9)
+    return (s == FULL).any(axis=1) & (s == EMPTY).any(axis=1)
 
 
 def _settle(plan: tuple, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:

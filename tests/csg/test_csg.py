@@ -352,3 +352,39 @@ def test_culling_children_by_their_support_changes_no_state():
         hi = lo + rng.choice([1 / 16, 1 / 8, 1 / 2], (3000, 1))
         culled = exact_classifier(whole, settle=True)(lo, hi)
         assert np.array_equal(culled, exact_classifier(_unculled(whole), settle=True)(lo, hi))
+
+
+def test_corner_witnesses_settle_as_halving_does(monkeypatch):
+    """Boxes that two exact surfaces meet are first decided by their corners and centre
+    (a point inside and one outside: the box meets the surface); the states are those
+    of halving alone: on near-coincident meshes (a sphere and the same sphere turned,
+    as OpenSCAD's example010 intersects a heightmap with its turned copy), across the
+    gap between two meshes (where halving finds the boxes EMPTY, and no witness may
+    say otherwise), and with interval leaves."""
+    from csg import classify
+    turned = Polyhedron(SPHERE_MESH) & Polyhedron(SPHERE_MESH).rotate((1, 2, 3), 7)
+    apart = Polyhedron(SPHERE_MESH) & Polyhedron(SPHERE_MESH).translate((2.02, 0, 0))
+    blend = Polyhedron(SPHERE_MESH) - smooth_union(Sphere(0.4), Sphere(0.4, center=(0.5, 0, 0)),
+                                                   0.2)
+    rng = np.random.default_rng(3)
+    on_sphere = rng.normal(size=(4000, 3))
+    on_sphere /= np.linalg.norm(on_sphere, axis=1, keepdims=True)
+    on_gap = rng.uniform((0.9, -0.1, -0.1), (1.1, 0.1, 0.1), (4000, 3))
+    settled = []
+    for tree, near in ((turned, on_sphere), (apart, on_gap), (blend, on_sphere)):
+        whole = classify.plan(tree)
+        size = rng.choice([1 / 32, 1 / 16, 1 / 8], (4000, 1))
+        lo = near - size * rng.uniform(0.2, 0.8, (4000, 1))
+        hi = lo + size
+        raw = classify._run(whole, lo, hi)
+        unsure = (raw == classify.UNKNOWN) | (raw == classify.MAYBE)
+        assert unsure.sum() > 100
+        fast = classify.exact_classifier(whole, settle=True)(lo, hi)
+        with monkeypatch.context() as m:
+            m.setattr(classify, "_witnessed", lambda plan, a, b: np.zeros(len(a), dtype=bool))
+            slow = classify.exact_classifier(whole, settle=True)(lo, hi)
+        assert np.array_equal(fast, slow)
+        settled.append((classify._witnessed(whole, lo[unsure], hi[unsure]).mean(),
+                        (slow[unsure] == EMPTY).mean()))
+    assert settled[0][0] > 0.9 and settled[2][0] > 0.5      # the witnesses do the work
+    assert settled[1][1] > 0.5                               # halving finds EMPTY boxes
