@@ -35,10 +35,10 @@ from typing import Optional
 
 import numpy as np
 
-from .planar import Circle, Polygon, Rectangle
+from .planar import Circle, Polygon, Rectangle, pieces_polygon
 from .solid import Difference, Intersection, Solid, Transformed, Union
 
-__all__ = ["region_paths", "region_pieces", "offset", "to_polygon", "clip", "to_clipper",
+__all__ = ["region_paths", "region_pieces", "simple_pieces", "offset", "to_polygon", "clip", "to_clipper",
            "CLIPPER_SCALE",
            "MITER_LIMIT", "NotFlat"]
 
@@ -128,11 +128,21 @@ def region_pieces(solid: Solid) -> list[tuple[np.ndarray, list[np.ndarray]]]:
     NotFlat
         As :func:`region_paths`.
     """
+    return _tree_pieces(region_paths(solid))
+
+
+def _tree_pieces(paths: list) -> list[tuple[np.ndarray, list[np.ndarray]]]:
+    """Clipper's outlines (integer paths, not crossing) as parts ``(outer, [holes])``,
+    from Clipper's own tree of outlines, every ring simple."""
     import pyclipper
-    paths = _usable(region_paths(solid))
+    paths = _usable(paths)
     if not paths:
         return []
     clipper = pyclipper.Pyclipper()
+    # rings that touch themselves at a vertex (Clipper's "weakly simple" output, as in
+    # GEB's shadows) are split into simple rings: the same region, and outlines whose
+    # triangulation and crossing number need no special case
+    clipper.StrictlySimple = True
     clipper.AddPaths(paths, pyclipper.PT_SUBJECT, True)
     tree = clipper.Execute2(pyclipper.CT_UNION, pyclipper.PFT_NONZERO, pyclipper.PFT_NONZERO)
     pieces = []
@@ -147,15 +157,36 @@ def region_pieces(solid: Solid) -> list[tuple[np.ndarray, list[np.ndarray]]]:
     return [(o, hs) for o, hs in pieces if len(o) >= 3]
 
 
+def simple_pieces(pieces: list) -> list[tuple[np.ndarray, list[np.ndarray]]]:
+    """Region parts ``(outer, [holes])`` with every ring simple: parts whose rings
+    touch themselves at a vertex are split by Clipper (StrictlySimple) into simple
+    rings of the same region; the rest are returned as they are. Points are on
+    Clipper's grid already when they came from Clipper, so they are kept exactly.
+
+    >>> import numpy as np
+    >>> eight = np.array([[1, 1], [3, 1], [3, 3], [5, 3], [5, 5], [3, 5], [3, 3], [1, 3.0]])
+    >>> [(len(o), [len(h) for h in hs]) for o, hs in simple_pieces([(eight, [])])]
+    [(4, []), (4, [])]
+    """
+    def touching(ring: np.ndarray) -> bool:
+        return len(np.unique(ring, axis=0)) < len(ring)
+
+    plain, split = [], []
+    for outer, holes in pieces:
+        rings = [np.asarray(r, dtype=np.float64) for r in (outer, *holes)]
+        (split if any(touching(r) for r in rings) else plain).append((rings[0], rings[1:]))
+    if not split:
+        return plain
+    paths = [np.round(r * CLIPPER_SCALE).astype(np.int64).tolist()
+             for outer, holes in split for r in (outer, *holes)]
+    return plain + _tree_pieces(paths)
+
+
 def to_polygon(paths: list) -> Optional[Polygon]:
-    """Clipper's outlines as a :class:`~csg.planar.Polygon` (even-odd), or None."""
-    paths = _usable(paths)
-    if not paths:
-        return None
-    outlines = [np.asarray(p, dtype=np.float64) / CLIPPER_SCALE for p in paths]
-    points = np.concatenate(outlines)
-    starts = np.cumsum([0] + [len(o) for o in outlines])
-    return Polygon(points, [list(range(a, b)) for a, b in zip(starts[:-1], starts[1:])])
+    """Clipper's outlines as a :class:`~csg.planar.Polygon` (its nesting from Clipper's
+    tree of outlines: rings touching at a vertex stay apart), or None."""
+    pieces = _tree_pieces(paths)
+    return pieces_polygon(pieces) if pieces else None
 
 
 def offset(solid: Solid, delta: float, join: str = "round", fragments: Optional[int] = None

@@ -36,8 +36,8 @@ from .facets import polygonal_radius
 from .solid import Bounds, Solid, Union
 from .triangulate import triangulate
 
-__all__ = ["Circle", "Rectangle", "Polygon", "linear_extrude", "rotate_extrude",
-           "LinearExtrude", "RotateExtrude"]
+__all__ = ["Circle", "Rectangle", "Polygon", "pieces_polygon", "linear_extrude",
+           "rotate_extrude", "LinearExtrude", "RotateExtrude"]
 
 
 class Shape2D(Solid):
@@ -227,6 +227,16 @@ def _max_of_edges(poly: np.ndarray, order, closed: bool = True) -> Expr:
     return iv.max(*edges) if len(edges) > 1 else edges[0]
 
 
+def _given_pieces(pieces: Sequence, n_paths: int) -> list[tuple[int, list[int]]]:
+    """``pieces`` checked: every path once, as an outline or as a hole of one."""
+    out = [(int(k), [int(h) for h in holes]) for k, holes in pieces]
+    used = sorted([k for k, _ in out] + [h for _, hs in out for h in hs])
+    if used != list(range(n_paths)):
+        raise ValueError(f"pieces must name each of the {n_paths} paths once, as an outline "
+                         "or a hole")
+    return out
+
+
 def _even_odd_pieces(points: np.ndarray, paths: list[list[int]]) -> list[tuple[int, list[int]]]:
     """Nest non-crossing paths by containment (a path is inside another when most of
     its vertices are: a shared vertex does not decide) and pair each even-depth path
@@ -256,6 +266,9 @@ class Polygon(Shape2D):
     nested by containment (they must not cross, as OpenSCAD's own polygons do
     not), and each path at an even depth minus the paths directly inside it is
     one piece of the region (:attr:`pieces`): its function is exact in sign.
+    Where the nesting is known (Clipper's tree of outlines, whose rings may touch
+    at a vertex, where containment by vertices cannot tell), pass it as
+    ``pieces=[(outline, [holes]), ...]`` (path indices).
 
     Examples
     --------
@@ -268,7 +281,8 @@ class Polygon(Shape2D):
     [(0, [1]), (2, [])]
     """
 
-    def __init__(self, points: Any, paths: Optional[Sequence[Sequence[int]]] = None):
+    def __init__(self, points: Any, paths: Optional[Sequence[Sequence[int]]] = None, *,
+                 pieces: Optional[Sequence[tuple[int, Sequence[int]]]] = None):
         pts = np.asarray(points, dtype=np.float64)
         if pts.ndim != 2 or pts.shape[1] != 2 or len(pts) < 3 or not np.all(np.isfinite(pts)):
             raise ValueError("points must be at least 3 finite (x, y) pairs")
@@ -282,7 +296,8 @@ class Polygon(Shape2D):
         self._regions = [self._path_expr(p) for p in self.paths]
         #: the region as pieces ``(path, [paths directly inside it])``: each path at an
         #: even depth of the nesting, minus those one level deeper inside it
-        self.pieces = _even_odd_pieces(pts, self.paths)
+        self.pieces = _even_odd_pieces(pts, self.paths) if pieces is None else \
+            _given_pieces(pieces, len(self.paths))
 
     def _path_expr(self, path: list[int]) -> Expr:
         poly = self.points[path]
@@ -319,6 +334,27 @@ class Polygon(Shape2D):
     def scene_node(self) -> dict:
         """This node of a JSON scene (:mod:`csg.scene`)."""
         return {"type": "polygon", "points": self.points.tolist(), "paths": self.paths}
+
+
+def pieces_polygon(pieces: Sequence[tuple[Any, Sequence[Any]]]) -> Polygon:
+    """A :class:`Polygon` of a region given in parts ``(outline, [holes])`` ((k, 2)
+    arrays, as :func:`csg.clipper2d.region_pieces` gives them): its nesting is
+    taken as given, not found again by containment.
+
+    >>> square = lambda c, h: [[c - h, c - h], [c + h, c - h], [c + h, c + h], [c - h, c + h]]
+    >>> pieces_polygon([(square(0, 3), [square(0, 2)]), (square(0, 1), [])]).pieces
+    [(0, [1]), (2, [])]
+    """
+    rings, parts = [], []
+    for outer, holes in pieces:
+        k = len(rings)
+        rings += [np.asarray(r, dtype=np.float64) for r in (outer, *holes)]
+        parts.append((k, list(range(k + 1, len(rings)))))
+    if not rings:
+        raise ValueError("a polygon needs at least one outline")
+    starts = np.cumsum([0] + [len(r) for r in rings])
+    return Polygon(np.concatenate(rings),
+                   [list(range(a, b)) for a, b in zip(starts[:-1], starts[1:])], pieces=parts)
 
 
 def _as_2d(shape: Solid) -> Solid:

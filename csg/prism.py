@@ -42,8 +42,9 @@ from implicitvox.triangles.ranges import buckets, expand, expand_boxes, gather
 from implicitvox.triangles.pairs import sorted_unique
 
 from .classify import MeshClassifier
+from .clipper2d import simple_pieces
 from .facets import extrusion_mesh_outlines
-from .planar import LinearExtrude, Polygon
+from .planar import LinearExtrude, pieces_polygon
 
 __all__ = ["Prism", "PrismClassifier", "axis_permutation"]
 
@@ -167,14 +168,12 @@ class Prism(LinearExtrude):
     exact = True
 
     def __init__(self, pieces: list, height: float, center: bool = False):
+        pieces = simple_pieces(pieces)       # a ring touching itself: split, the same region
         rings = [np.asarray(r, dtype=np.float64) for outer, holes in pieces
                  for r in (outer, *holes)]
         if not rings:
             raise ValueError("a Prism needs at least one outline")
-        starts = np.cumsum([0] + [len(r) for r in rings])
-        super().__init__(Polygon(np.concatenate(rings),
-                                 [list(range(s, t)) for s, t in zip(starts[:-1], starts[1:])]),
-                         height, center=center)
+        super().__init__(pieces_polygon(pieces), height, center=center)
         self.pieces = [(np.asarray(o, dtype=np.float64), [np.asarray(h, dtype=np.float64)
                                                            for h in hs]) for o, hs in pieces]
 
