@@ -57,7 +57,7 @@ def test_openscad_extrusions_are_prisms_and_exact():
     assert vox.count == mesh.count and np.all(vox.contains(mesh.coords()))
 
 
-def test_a_ring_touching_itself_gets_the_exact_tests_sign():
+def test_a_ring_touching_itself_gets_the_exact_tests_sign(monkeypatch):
     """A hole of GEB's shadow as Clipper once gave it: one ring touching itself at three
     vertices. Its triangulated function was inside where the crossing number is
     outside, over half its box, so the intervals dropped 416 surface voxels of GEB.
@@ -70,6 +70,8 @@ def test_a_ring_touching_itself_gets_the_exact_tests_sign():
     ring = np.loadtxt(Path(__file__).parents[1] / "openscad" / "geb_shadow_ring.txt")
     assert len(np.unique(ring, axis=0)) < len(ring)                  # it touches itself
     outer = np.array([[-20.0, -19], [19, -19], [19, 20], [-20, 20]])
+    from csg import prism as prism_module
+    monkeypatch.setattr(prism_module, "FUNCTION_VERTICES", 10 ** 6)   # its own function
     prism = Prism([(outer, [ring])], 1.0)
     f = iv.compile(prism.expr)
     rng = np.random.default_rng(4)
@@ -103,3 +105,23 @@ def test_the_function_keeps_clippers_nesting_where_rings_touch():
     in_hole = (p[off, 0] > 1.1) & (p[off, 0] < 2.9) & (p[off, 1] > 1.1) & (p[off, 1] < 2.9)
     above = p[off, 1] > p[off, 0] + 0.05                   # the hole's half the island leaves
     assert in_hole[above].any() and not (state[off] == FULL)[in_hole & above].any()
+
+
+def test_a_long_outline_has_a_bound_for_its_function_and_the_same_voxels(monkeypatch):
+    """Past FUNCTION_VERTICES outline vertices the prism's function is only a bound (its
+    box): the exact test decides every box, giving the voxels of the full function."""
+    from csg import prism as prism_module
+    from tests.golden.digests import voxel_digests
+    angle = np.linspace(0, 2 * np.pi, 400, endpoint=False)
+    radius = 1 + 0.3 * np.sin(7 * angle)
+    gear = np.column_stack([np.cos(angle), np.sin(angle)]) * radius[:, None]
+    hole = 0.3 * np.column_stack([np.cos(angle), -np.sin(angle)])[::8]
+    body = Prism([(gear, [hole])], 0.5)
+    assert body.needs_exact_test and not body.expression_is_exact
+    bounded = body.rotate("x", 90).voxelize(48, interior=True)
+    with monkeypatch.context() as m:
+        m.setattr(prism_module, "FUNCTION_VERTICES", 10 ** 6)
+        full = Prism([(gear, [hole])], 0.5)
+        assert not full.needs_exact_test
+        exact = full.rotate("x", 90).voxelize(48, interior=True)
+    assert bounded.count > 0 and voxel_digests(bounded) == voxel_digests(exact)
