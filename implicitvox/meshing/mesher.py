@@ -141,8 +141,9 @@ def mesh_grid(shape: Any, grid: Grid, *, refine: int = REFINE,
 
     shape = as_shape(shape)
     if not expression_is_exact(shape):
-        raise ValueError("this solid holds polyhedra (OpenSCAD's facets, polyhedron(), imported "
-                         "meshes) whose expressions only bound them, and meshing needs the "
+        raise ValueError("this solid holds polyhedra (OpenSCAD's faceted spheres, extruded "
+                         "text and other long outlines, polyhedron(), imported meshes) whose "
+                         "expressions only bound them, and meshing needs the "
                          "solid's own function: read OpenSCAD models with facets='true' (the "
                          "true curves), or voxelize the solid")
     func = Function(shape.expr)

@@ -205,9 +205,17 @@ def test_to_mesh_uses_the_voxels_grid_and_refuses_without_a_shape(tmp_path):
 
 
 def test_polyhedra_are_refused_clearly():
-    solid = csg.read_openscad(str(FIXTURES / "bracket.csg"), facets="openscad")
+    # an imported mesh: its function is only a bound
+    solid = csg.read_openscad(str(FIXTURES / "imported.csg"), facets="openscad")
     with pytest.raises(ValueError, match="facets='true'"):
         ivx.mesh(solid, resolution=16)
+
+
+def test_openscads_faceted_cylinders_are_meshed():
+    # a plane per facet (csg.ConvexPolyhedron): a true function, so a mesh
+    solid = csg.read_openscad(str(FIXTURES / "bracket.csg"), facets="openscad")
+    assert solid.expression_is_exact
+    assert ivx.mesh(solid, resolution=16).n_cells > 100
 
 
 @pytest.mark.parametrize("kwargs, match", [
