@@ -117,12 +117,11 @@ def exact_classifier(tree_plan: Optional[tuple], settle: bool = False
         # halved too, as the voxelizer rechecks voxels with no exact test
         unsure = (state == UNKNOWN) | (state == MAYBE)
         unknown = np.flatnonzero(unsure) if settle else np.zeros(0, dtype=np.int64)
-        if len(unknown):
-            seen = _witnessed(tree_plan, lo[unknown], hi[unknown])
-            state[unknown[seen]] = AMBIGUOUS
-            unknown = unknown[~seen]
         for start in range(0, len(unknown), SETTLE_CHUNK):
             part = unknown[start:start + SETTLE_CHUNK]
+            seen = _witnessed(tree_plan, lo[part], hi[part])
+            state[part[seen]] = AMBIGUOUS
+            part = part[~seen]
             state[part] = _settle(tree_plan, lo[part], hi[part])
         state[(state == MAYBE) | (state == UNKNOWN)] = AMBIGUOUS
         return state

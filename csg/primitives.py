@@ -26,7 +26,7 @@ from implicitvox.triangles.inputs import as_triangles
 from implicitvox.octree.morton import CORNERS
 
 from .classify import MeshClassifier, similarity_scale
-from .solid import Bounds, Solid, vector
+from .solid import Bounds, Solid, box_bound, vector
 
 __all__ = ["Sphere", "Box", "Cylinder", "Torus", "Ellipsoid", "HalfSpace", "ConvexPolyhedron",
            "Polyhedron"]
@@ -387,9 +387,7 @@ class Polyhedron(Solid):
 
     @property
     def expr(self) -> Expr:
-        c, h = (self._lo + self._hi) / 2, (self._hi - self._lo) / 2
-        outside = iv.max(abs(x - c[0]) - h[0], abs(y - c[1]) - h[1], abs(z - c[2]) - h[2])
-        return iv.max(outside, 0.0)
+        return box_bound(self._lo, self._hi)
 
     @property
     def bounds(self) -> Bounds:

@@ -35,8 +35,7 @@ from typing import Any, Optional
 
 import numpy as np
 
-import implicitvox as iv
-from implicitvox import linf, x, y, z
+from implicitvox import linf
 from implicitvox.expr.shape import AMBIGUOUS, EMPTY, FULL
 from implicitvox.triangles.predicates import det2_sign
 from implicitvox.triangles.ranges import buckets, expand, expand_boxes, gather
@@ -46,6 +45,7 @@ from .classify import MeshClassifier
 from .clipper2d import simple_pieces
 from .facets import extrusion_mesh_outlines
 from .planar import LinearExtrude, pieces_polygon
+from .solid import box_bound
 
 __all__ = ["Prism", "PrismClassifier", "axis_permutation", "FUNCTION_VERTICES"]
 
@@ -177,25 +177,19 @@ class Prism(LinearExtrude):
     exact = True
 
     def __init__(self, pieces: list, height: float, center: bool = False):
-        pieces = simple_pieces(pieces)       # a ring touching itself: split, the same region
-        rings = [np.asarray(r, dtype=np.float64) for outer, holes in pieces
-                 for r in (outer, *holes)]
-        if not rings:
+        #: the region's parts, every ring simple (a ring touching itself is split:
+        #: the same region)
+        self.pieces = simple_pieces(pieces)
+        if not self.pieces:
             raise ValueError("a Prism needs at least one outline")
-        super().__init__(pieces_polygon(pieces), height, center=center)
-        self.pieces = [(np.asarray(o, dtype=np.float64), [np.asarray(h, dtype=np.float64)
-                                                           for h in hs]) for o, hs in pieces]
+        super().__init__(pieces_polygon(self.pieces), height, center=center)
         #: the function is only a bound: the exact test must classify every box
-        self.needs_exact_test = sum(len(r) for r in rings) > FUNCTION_VERTICES
+        self.needs_exact_test = sum(len(o) + sum(len(h) for h in hs)
+                                    for o, hs in self.pieces) > FUNCTION_VERTICES
 
     @property
     def expr(self):
-        if not self.needs_exact_test:
-            return super().expr
-        (x0, y0, z0), (x1, y1, z1) = self.bounds
-        c, h = np.array([x0 + x1, y0 + y1, z0 + z1]) / 2, np.array([x1 - x0, y1 - y0, z1 - z0]) / 2
-        outside = iv.max(abs(x - c[0]) - h[0], abs(y - c[1]) - h[1], abs(z - c[2]) - h[2])
-        return iv.max(outside, 0.0)
+        return box_bound(*self.bounds) if self.needs_exact_test else super().expr
 
     def mesh(self, matrix: Optional[np.ndarray] = None) -> tuple[np.ndarray, np.ndarray]:
         """The prism's closed triangle mesh (vertices, faces), moved by ``matrix``."""
