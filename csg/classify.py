@@ -65,6 +65,9 @@ SETTLE_DEPTH = 2
 #: unknown boxes settled at once (each may have up to 4**SETTLE_DEPTH sub-boxes in play)
 SETTLE_CHUNK = batches.SETTLE_BOXES
 _HALF = CORNERS.astype(bool)
+#: the witness points of a box (its corners in :data:`CORNERS` order, then its centre),
+#: in the order :func:`_witnessed` tries them: two opposite corners, then the rest
+_WITNESS_STAGES = (np.array([0, 7]), np.array([1, 2, 3, 4, 5, 6, 8]))
 _BOOLEANS = ("union", "intersection", "difference", "complement")
 
 
@@ -171,10 +174,27 @@ def _boolean(kind: str, kids: list) -> tuple:
     """A union or intersection node: its children and their supports (stacked:
     ``lo`` (k, 3), ``hi`` (k, 3), the state off the box (k,)), so that a box
     evaluates only the children whose support box it touches."""
+    # the cheap children first: a box one child makes absorbing (EMPTY for an
+    # intersection, FULL for a union) skips the rest (:func:`_run`), and the
+    # combination is symmetric in the children, so the order changes no state
+    kids = sorted(kids, key=_interval_cost)
     supports = [_support(k) for k in kids]
     lo = np.array([sp[0] for sp in supports], dtype=np.float64).reshape(-1, 3)
     hi = np.array([sp[1] for sp in supports], dtype=np.float64).reshape(-1, 3)
     return (kind, kids, (lo, hi, np.array([sp[2] for sp in supports], dtype=np.int8)))
+
+
+def _interval_cost(node: tuple) -> int:
+    """The instructions of a node's interval leaves: the part of its cost that
+    grows with its tapes (an exact leaf's test costs about one instruction)."""
+    kind = node[0]
+    if kind == "function":
+        return len(node[1].tape)
+    if kind == "complement":
+        return _interval_cost(node[1])
+    if kind in ("union", "intersection"):
+        return sum(_interval_cost(k) for k in node[1])
+    return 1
 
 
 def _support(node: tuple) -> tuple[np.ndarray, np.ndarray, int]:
@@ -232,14 +252,19 @@ def _run(plan: tuple, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
     klo, khi, koff = plan[2]
     touches = np.all((lo[None] <= khi[:, None]) & (hi[None] >= klo[:, None]), axis=2)
     states = np.repeat(koff[:, None], len(lo), axis=1)
-    for k, kid in enumerate(plan[1]):        # each child only where its support reaches
-        if touches[k].all():
-            states[k] = _run(kid, lo, hi)
-        elif touches[k].any():
-            near = np.flatnonzero(touches[k])
-            states[k, near] = _run(kid, lo[near], hi[near])
     # a union is an intersection of complements: one rule, with the roles swapped
     absorbing, neutral = (FULL, EMPTY) if kind == "union" else (EMPTY, FULL)
+    open_ = koff != absorbing       # boxes no child has made absorbing yet
+    open_ = np.ones(len(lo), dtype=bool) if open_.all() else \
+        ~((~touches) & (koff == absorbing)[:, None]).any(axis=0)
+    for k, kid in enumerate(plan[1]):        # each child only where its support reaches
+        ask = touches[k] & open_             # and where no child decided the box already
+        if ask.all():
+            states[k] = _run(kid, lo, hi)
+        elif ask.any():
+            near = np.flatnonzero(ask)
+            states[k, near] = _run(kid, lo[near], hi[near])
+        open_ &= states[k] != absorbing
     out = np.full(len(lo), UNKNOWN, dtype=np.int8)
     active = states != neutral
     n_active = active.sum(axis=0)
@@ -257,12 +282,25 @@ def _witnessed(plan: tuple, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
     their corners and centres: a box is connected, so such a box meets the
     surface (AMBIGUOUS, as :func:`_settle` would find it, at a ninth of the
     cost of its first halving). A point is classified as the degenerate box
-    ``[p, p]``, by the same exact tests: FULL or EMPTY only off every surface."""
+    ``[p, p]``, by the same exact tests: FULL or EMPTY only off every surface.
+
+    Two opposite corners go first; only boxes they leave unwitnessed have their
+    other seven points classified (the answer is that of all nine at once)."""
     mid = 0.5 * (lo + hi)                                   # rounded, but inside the box
     points = np.concatenate([np.where(_HALF[None], hi[:, None], lo[:, None]),
-                             mid[:, None]], axis=1).reshape(-1, 3)
-    s = _run(plan, points, points).reshape(len(lo), 9)
-    return (s == FULL).any(axis=1) & (s == EMPTY).any(axis=1)
+                             mid[:, None]], axis=1)         # (n, 9, 3)
+    seen_full = np.zeros(len(lo), dtype=bool)
+    seen_empty = np.zeros(len(lo), dtype=bool)
+    boxes = np.arange(len(lo))
+    for stage in _WITNESS_STAGES:
+        p = points[boxes][:, stage].reshape(-1, 3)
+        s = _run(plan, p, p).reshape(len(boxes), len(stage))
+        seen_full[boxes] |= (s == FULL).any(axis=1)
+        seen_empty[boxes] |= (s == EMPTY).any(axis=1)
+        boxes = boxes[~(seen_full[boxes] & seen_empty[boxes])]
+        if not len(boxes):
+            break
+    return seen_full & seen_empty
 
 
 def _settle(plan: tuple, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
@@ -349,7 +387,7 @@ class MeshClassifier:
         if len(rest):
             # off the surface: the whole box is on the side of its centre (a box corner
             # is exact and in the box: use it, the rounded centre could leave a thin box)
-            w = self.winding(lo[rest])
+            w = self.winding.of_boxes(lo[rest], hi[rest])
             state[rest] = np.where(w != 0, FULL, EMPTY)
         return state
 

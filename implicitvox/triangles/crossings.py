@@ -35,7 +35,7 @@ from .predicates import det2_sign, orient3d_sign
 from .ranges import buckets, expand_boxes, gather, grid_cells
 from .tribox import Triangles
 
-__all__ = ["RayWinding", "CELLS_PER_ROOT"]
+__all__ = ["RayWinding", "CELLS_PER_ROOT", "face_groups"]
 
 #: grid cells per axis over the square root of the triangle count: more cells, fewer
 #: candidate triangles per query and more (cell, triangle) entries (measured on a
@@ -76,6 +76,14 @@ class RayWinding:
         c = np.floor((p - self.lo2) / self.size).astype(np.int64)
         return np.clip(c, 0, self.cells - 1)
 
+    def of_boxes(self, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+        """Winding numbers ``(n,)`` of closed boxes ``[lo, hi]`` known to be off the
+        surface (no triangle meets them): constant over each box, and over each
+        group of boxes joined by shared faces (:func:`face_groups`), so one corner
+        per group is asked."""
+        group, first = face_groups(lo, hi)
+        return self(lo[first])[group]
+
     def __call__(self, points: np.ndarray) -> np.ndarray:
         """Winding numbers ``(n,)`` (ints) at ``points (n, 3)``."""
         p = np.asarray(points, dtype=np.float64).reshape(-1, 3)
@@ -105,3 +113,62 @@ class RayWinding:
         hit = inside & ahead
         np.add.at(out, pts[hit], sx[hit])
         return out
+
+
+def face_groups(lo: np.ndarray, hi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Boxes ``[lo, hi]`` (n, 3) grouped by shared faces: ``group (n,)``, each box's
+    group, and ``first``, one box of each group.
+
+    Two boxes are joined where the upper face of one along an axis is, float for
+    float, the lower face of the other (equal extents across, equal coordinate
+    along): the union of two such closed boxes is connected. So over boxes that
+    no surface meets, a group lies on one side of it. Boxes touching only along
+    an edge, or meeting faces of different sizes, stay apart (a group too many
+    is only a query too many).
+
+    Examples
+    --------
+    >>> lo = np.array([[0., 0, 0], [1, 0, 0], [3, 0, 0]])
+    >>> group, first = face_groups(lo, lo + 1)
+    >>> group.tolist(), first.tolist()
+    ([0, 0, 1], [0, 2])
+    """
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+    n = len(lo)
+    if n < 2:
+        return np.zeros(n, dtype=np.int64), np.arange(n)
+    lo, hi = lo + 0.0, hi + 0.0                              # -0.0 as 0.0: keys by bits
+    rows, cols = [], []
+    for a in range(3):
+        b, c = (a + 1) % 3, (a + 2) % 3
+        across = np.column_stack([lo[:, b], hi[:, b], lo[:, c], hi[:, c]])
+        lower = np.column_stack([lo[:, a], across])
+        upper = np.column_stack([hi[:, a], across])
+        low_key, up_key = _face_hash(lower), _face_hash(upper)
+        order = np.argsort(low_key)
+        at = np.minimum(np.searchsorted(low_key[order], up_key), n - 1)
+        other = order[at]
+        # a hash is only a hint: the faces must be equal, float for float
+        match = np.all(lower[other] == upper, axis=1)
+        rows.append(np.flatnonzero(match))
+        cols.append(other[match])
+    r, c = np.concatenate(rows), np.concatenate(cols)
+    graph = coo_matrix((np.ones(len(r), dtype=np.int8), (r, c)), shape=(n, n))
+    count, group = connected_components(graph, directed=False)
+    first = np.full(count, n, dtype=np.int64)
+    np.minimum.at(first, group, np.arange(n))
+    return group.astype(np.int64), first
+
+
+#: odd multipliers mixing a face's five coordinates (their bits) into one key
+_MIX = np.array([0x9E3779B97F4A7C15, 0xC2B2AE3D27D4EB4F, 0x165667B19E3779F9,
+                 0xD6E8FEB86659FD93, 0xFF51AFD7ED558CCD], dtype=np.uint64)
+
+
+def _face_hash(faces: np.ndarray) -> np.ndarray:
+    """A 64-bit key per row of five floats (wrapping products of their bits)."""
+    bits = np.ascontiguousarray(faces).view(np.uint64)
+    with np.errstate(over="ignore"):
+        key = (bits * _MIX).sum(axis=1, dtype=np.uint64)
+        return key ^ (key >> np.uint64(29))

@@ -41,6 +41,7 @@ __all__ = ["voxelize", "estimate_memory", "bytes_per_voxel", "grid_of", "Implici
 _BYTES_PER_VOXEL = 48
 _BYTES_PER_NORMAL = 24
 _PILOT_DEPTH = 6
+_PILOT_BELOW = 2
 #: bytes of working interval arrays per box in a chunk (a few dozen float64 registers)
 _BYTES_PER_BOX = 512
 #: a run whose surface voxels are at least this share of a grid of at least
@@ -53,12 +54,12 @@ def estimate_memory(func: Function, grid: Grid, normals: bool = False, prune: bo
                     ) -> tuple[int, int]:
     """Estimated surface voxels and peak bytes of a voxelization.
 
-    A pilot subdivision to depth ``min(depth, 6)`` counts the AMBIGUOUS
+    A pilot subdivision to depth :func:`pilot_depth_for` counts the AMBIGUOUS
     octants there and extrapolates with Stolte's growth factor of 4 per level
     (§4.1.3); the working set of the subdivision itself is bounded.
     """
     depth = grid.depth
-    pilot_depth = min(depth, _PILOT_DEPTH)
+    pilot_depth = pilot_depth_for(depth)
     pilot = grid.coarser(depth - pilot_depth)
     # The pilot's voxels are unions of grid voxels; crop effects are ignored.
     # No recheck: the pilot is cheaper and its count an upper estimate.
@@ -66,6 +67,14 @@ def estimate_memory(func: Function, grid: Grid, normals: bool = False, prune: bo
     cells = int(np.prod(grid.shape, dtype=np.float64))
     voxels = min(found * 4 ** (depth - pilot_depth), cells)
     return int(voxels), int(voxels * bytes_per_voxel(normals) + working_bytes(grid))
+
+
+def pilot_depth_for(depth: int) -> int:
+    """The depth of the pilot run of a grid of ``depth`` levels: :data:`_PILOT_DEPTH`
+    (64³), and at least :data:`_PILOT_BELOW` levels coarser than the grid (a
+    sixteenth of its voxels), so that the estimate costs little beside the run
+    even on small grids; the whole grid only when it has 2 levels or fewer."""
+    return max(min(depth, 2), min(_PILOT_DEPTH, depth - _PILOT_BELOW))
 
 
 def working_bytes(grid: Grid) -> int:
