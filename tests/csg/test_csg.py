@@ -388,3 +388,58 @@ def test_corner_witnesses_settle_as_halving_does(monkeypatch):
                         (slow[unsure] == EMPTY).mean()))
     assert settled[0][0] > 0.9 and settled[2][0] > 0.5      # the witnesses do the work
     assert settled[1][1] > 0.5                               # halving finds EMPTY boxes
+
+
+def _every_child(plan: tuple, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+    """The states of a plan by its rules, every child asked about every box (the
+    reference for the classifier, which skips children where another decided)."""
+    from csg import classify
+    kind = plan[0]
+    if kind in ("union", "intersection"):
+        states = np.array([_every_child(k, lo, hi) for k in plan[1]])
+        absorbing, neutral = (FULL, EMPTY) if kind == "union" else (EMPTY, FULL)
+        active = states != neutral
+        out = np.full(len(lo), classify.UNKNOWN, dtype=np.int8)
+        one = active.sum(axis=0) == 1
+        out[one] = states[active.argmax(axis=0)[one], np.flatnonzero(one)]
+        out[(active.sum(axis=0) > 1) & (states == classify.MAYBE).any(axis=0)] = classify.MAYBE
+        out[~active.any(axis=0)] = neutral
+        out[(states == absorbing).any(axis=0)] = absorbing
+        return out
+    if kind == "complement":
+        s = _every_child(plan[1], lo, hi)
+        return np.where(s == FULL, EMPTY, np.where(s == EMPTY, FULL, s)).astype(np.int8)
+    return classify._run(plan, lo, hi)
+
+
+def test_children_decided_by_another_are_skipped_and_change_no_state(monkeypatch):
+    """A box one child makes absorbing (EMPTY in an intersection, FULL in a union)
+    asks no other child, the interval leaves last; the states are those of asking
+    every child, in both orders of the operands."""
+    from csg import classify
+    blend = smooth_union(Sphere(0.4), Sphere(0.4, center=(0.5, 0, 0)), 0.2)
+    slab = Box((2, 0.4, 2), center=True)
+    trees = [Polyhedron(SPHERE_MESH) - blend, blend - Polyhedron(SPHERE_MESH),
+             blend & slab, slab & blend,
+             (Polyhedron(SPHERE_MESH) | blend) - Sphere(0.3, center=(0, 0.5, 0))]
+    rng = np.random.default_rng(11)
+    lo = rng.uniform(-1.2, 1.1, (3000, 3))
+    hi = lo + rng.choice([1 / 64, 1 / 16, 1 / 4], (3000, 1))
+    asked, exact_open = [], []
+    for tree in trees:
+        plan = classify.plan(tree)
+        exact_open.append((classify._run(plan[1][0], lo, hi) != EMPTY).sum())
+        assert np.array_equal(classify._run(plan, lo, hi), _every_child(plan, lo, hi))
+        seen = []
+        with monkeypatch.context() as m:
+            original = classify._run
+            m.setattr(classify, "_run", lambda p, a, b: (seen.append(len(a)) if p[0] == "function"
+                                                         else None) or original(p, a, b))
+            classify._run(plan, lo, hi)
+        asked.append(sum(seen))
+    # the exact child goes first, in either order written; the blend is asked only
+    # where it left the box open
+    for tree in trees[2:4]:
+        assert [kid[0] for kid in classify.plan(tree)[1]] == ["exact", "function"]
+    for k in (0, 2, 3):
+        assert 0 < asked[k] <= exact_open[k] < len(lo)

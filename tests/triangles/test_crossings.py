@@ -48,3 +48,46 @@ def test_long_thin_triangles_coarsen_the_grid_instead_of_filling_memory(monkeypa
     assert len(grid.cell_tris) <= max(ENTRIES_PER_ITEM * n, 1 << 20)
     p = np.random.default_rng(2).uniform(-0.1, 1.1, (1500, 3))
     assert np.array_equal(grid(p), _one_cell(monkeypatch, tris)(p))
+
+
+def _grid_boxes(n: int, keep: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The kept cells of an n³ grid over [-1.2, 1.2]³ as boxes (corners computed per
+    cell, as the octree computes them: shared faces are equal floats)."""
+    ijk = np.argwhere(keep)
+    edges = np.linspace(-1.2, 1.2, n + 1)
+    return edges[ijk], edges[ijk + 1]
+
+
+def test_face_groups_join_boxes_sharing_faces_and_no_others():
+    # two slabs of cells with a gap, and two cells touching only along an edge
+    keep = np.zeros((8, 8, 8), dtype=bool)
+    keep[0:2] = True
+    keep[4:6] = True
+    lo, hi = _grid_boxes(8, keep)
+    lo = np.concatenate([lo, [[5.0, 5, 5], [6, 6, 5]]])
+    hi = np.concatenate([hi, [[6.0, 6, 6], [7, 7, 6]]])
+    group, first = crossings.face_groups(lo, hi)
+    assert len(first) == 4
+    slab = lo[:, 0] < -0.5
+    assert len(np.unique(group[:len(slab) - 2][slab[:-2]])) == 1
+    assert group[-1] != group[-2]
+    assert np.array_equal(group[first], np.arange(len(first)))
+
+
+def test_boxes_off_the_surface_get_the_winding_of_their_corners():
+    # every grid cell that no triangle of a faceted sphere meets: one query per
+    # group, the same numbers as asking each box's own corner
+    v, f = as_triangles(pv.Sphere(radius=1.0, theta_resolution=17, phi_resolution=13))
+    winding = RayWinding(v[f])
+    from implicitvox.triangles.tribox import Triangles
+    tris = Triangles(v[f])
+    lo, hi = _grid_boxes(16, np.ones((16, 16, 16), dtype=bool))
+    box = np.repeat(np.arange(len(lo)), len(f))
+    tri = np.tile(np.arange(len(f)), len(lo))
+    met = np.zeros(len(lo), dtype=bool)
+    met[box[tris.meet_boxes(tri, lo[box], hi[box])]] = True
+    lo, hi = lo[~met], hi[~met]
+    w = winding.of_boxes(lo, hi)
+    assert np.array_equal(w, winding(lo))
+    assert set(np.unique(w)) == {0, 1}
+    assert len(crossings.face_groups(lo, hi)[1]) == 2        # inside and outside
