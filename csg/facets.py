@@ -40,8 +40,8 @@ from implicitvox import Expr, x, y
 
 __all__ = ["fragments", "helix_slices", "conical_helix_slices", "diagonal_slices",
            "extrusion_slices", "circle_points", "sphere_points", "cylinder_points",
-           "polygonal_radius", "extrusion_mesh", "extrusion_mesh_outlines", "MAX_FRAGMENTS",
-           "MAX_SPHERE_POINTS"]
+           "polygonal_radius", "FULL_SWEEP_START", "extrusion_mesh", "extrusion_mesh_outlines",
+           "MAX_FRAGMENTS", "MAX_SPHERE_POINTS"]
 
 GRID_FINE = 0.00000095367431640625
 #: side-quad diagonals whose squared lengths differ by at most this share are equal
@@ -206,9 +206,16 @@ def cylinder_points(r1: float, r2: float, z1: float, z2: float, n: int) -> np.nd
     return np.concatenate(pts)
 
 
-def polygonal_radius(n_sectors: int, angle: float) -> Expr:
+#: where OpenSCAD 2021.01 starts the sectors of a full ``rotate_extrude``: on the -x
+#: axis ("for legacy support", its ``rotateextrude.cc``); a partial one starts on +x
+FULL_SWEEP_START = 180.0
+
+
+def polygonal_radius(n_sectors: int, angle: float, start: float = 0.0) -> Expr:
     """``rho_n(x, y)``: the circumradius of the ``n_sectors``-sided sweep through ``(x, y)``
-    (sectors of ``angle / n_sectors`` degrees from the +x axis).
+    (sectors of ``angle / n_sectors`` degrees from ``start`` degrees: OpenSCAD 2021.01
+    starts a partial sweep on the +x axis, 0, and a full one on the -x axis, 180
+    (:data:`FULL_SWEEP_START`), which only an odd count of sectors tells apart).
 
     Within sector ``k`` it is the projection on the sector's mid-direction
     ``phi_k`` over ``cos(w / 2)``; the nearest mid-direction gives the largest
@@ -216,12 +223,12 @@ def polygonal_radius(n_sectors: int, angle: float) -> Expr:
     functions, whose intervals are tight (no angle, no floor).
     """
     w = angle / n_sectors
-    c, s = _cos_sin_degrees(w * (np.arange(n_sectors) + 0.5))
+    c, s = _cos_sin_degrees(start + w * (np.arange(n_sectors) + 0.5))
     scale = 1.0 / math.cos(math.radians(w / 2))
-    if n_sectors == 1 or w > 180:
+    if abs(w) >= 180:
         raise ValueError(f"{n_sectors} sector(s) over {angle} degrees: each must be < 180")
     terms = [(ci * scale) * x + (si * scale) * y for ci, si in zip(c, s)]
-    return iv.max(*terms)
+    return iv.max(*terms) if len(terms) > 1 else terms[0]
 
 
 def extrusion_mesh(outline: np.ndarray, height: float, twist: float, scale: np.ndarray,

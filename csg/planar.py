@@ -32,7 +32,7 @@ import numpy as np
 import implicitvox as iv
 from implicitvox import Expr, validate, x, y, z
 
-from .facets import polygonal_radius
+from .facets import FULL_SWEEP_START, polygonal_radius
 from .solid import Bounds, Solid, Union
 from .triangulate import triangulate
 
@@ -458,7 +458,9 @@ class RotateExtrude(Solid):
         if self.sectors is None:
             rho = iv.hypot(x, y)
         else:                                 # OpenSCAD's facets: planar trapezoid sectors
-            rho = polygonal_radius(self.sectors, self.angle if abs(self.angle) < 360 else 360.0)
+            full = abs(self.angle) >= 360
+            rho = polygonal_radius(self.sectors, 360.0 if full else self.angle,
+                                   FULL_SWEEP_START if full else 0.0)
         radial = rho if b is None or b[1][0] > 0 else -rho     # a shape at x <= 0 sweeps too
         solid = _mirrored(shape).expr.remap(x=radial, y=z)
         if abs(self.angle) >= 360:
