@@ -101,7 +101,8 @@ def _leaves(solid):
         yield from _leaves(c)
 
 
-def exact_classifier(tree_plan: Optional[tuple], settle: bool = False
+def exact_classifier(tree_plan: Optional[tuple], settle: bool = False,
+                     regularized: Optional[Callable[[], Any]] = None
                      ) -> Optional[Callable[[np.ndarray, np.ndarray], np.ndarray]]:
     """The box classifier of a tree's :func:`plan`, or None when it has none.
 
@@ -109,6 +110,14 @@ def exact_classifier(tree_plan: Optional[tuple], settle: bool = False
     them) are decided by subdivision (:func:`_settle`); without, they are
     AMBIGUOUS - right for an octant the voxelizer will subdivide anyway, and
     much cheaper. The voxelizer settles at the voxel level only.
+
+    A box that halving leaves unknown holds a tie: two surfaces touching along
+    a face or an edge inside it (solids touching on a face, common in OpenSCAD
+    models). ``regularized`` gives, when called, a classifier of the
+    regularized solid's boundary (the tree's mesh, whose booleans drop faces
+    shared inside the solid: :func:`csg.tree_mesh.tree_mesh`), or None where the
+    tree has none (a curved leaf); it decides those boxes, so a face shared by
+    two parts of a union is no surface. Without one they count as AMBIGUOUS.
     """
     if tree_plan is None:
         return None
@@ -126,6 +135,11 @@ def exact_classifier(tree_plan: Optional[tuple], settle: bool = False
             state[part[seen]] = AMBIGUOUS
             part = part[~seen]
             state[part] = _settle(tree_plan, lo[part], hi[part])
+        tied = np.flatnonzero(state == UNKNOWN) if settle else np.zeros(0, dtype=np.int64)
+        if len(tied) and regularized is not None:
+            boundary = regularized()
+            if boundary is not None:
+                state[tied] = boundary.classify(lo[tied], hi[tied])
         state[(state == MAYBE) | (state == UNKNOWN)] = AMBIGUOUS
         return state
     return classify
@@ -309,7 +323,7 @@ def _settle(plan: tuple, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
     A box meets the surface iff a sub-box does (an AMBIGUOUS sub-box), or it
     holds an inside and an outside sub-box (FULL and EMPTY: the box is
     connected); it is EMPTY (FULL) iff all its sub-boxes are. Unknown after
-    :data:`SETTLE_DEPTH` levels: AMBIGUOUS.
+    :data:`SETTLE_DEPTH` levels: UNKNOWN (a tie: :func:`exact_classifier`).
     """
     state = np.full(len(lo), UNKNOWN, dtype=np.int8)
     owner = np.arange(len(lo))
@@ -337,7 +351,6 @@ def _settle(plan: tuple, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
         state[settled] = np.where(seen_full[settled], FULL, EMPTY)
         keep = (s == UNKNOWN) & ~surface[cowner]
         owner, blo, bhi = cowner[keep], clo[keep], chi[keep]
-    state[state == UNKNOWN] = AMBIGUOUS
     return state
 
 

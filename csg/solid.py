@@ -34,7 +34,7 @@ import numpy as np
 import implicitvox as iv
 from implicitvox import Expr, validate, x, y, z
 
-from .classify import exact_classifier, plan, world_primitive
+from .classify import MeshClassifier, exact_classifier, plan, world_primitive
 
 __all__ = ["Solid", "Union", "Intersection", "Difference", "Complement", "Transformed",
            "ExprSolid", "Bounds", "rotation_matrix", "vector", "box_bound", "SCENE_FORMAT"]
@@ -164,8 +164,24 @@ class Solid:
     @property
     def classify_voxels(self) -> Optional[Callable[[np.ndarray, np.ndarray], np.ndarray]]:
         """The exact test at the voxel level: as :attr:`classify_boxes`, and where two
-        exact surfaces meet a box, decided by subdividing it (:mod:`csg.classify`)."""
-        return exact_classifier(self.exact_plan, settle=True)
+        exact surfaces meet a box, decided by subdividing it (:mod:`csg.classify`), and
+        where they touch (a tie no halving settles) by :attr:`regularized_boundary`."""
+        return exact_classifier(self.exact_plan, settle=True,
+                                regularized=lambda: self.regularized_boundary)
+
+    @functools.cached_property
+    def regularized_boundary(self) -> Optional[Any]:
+        """The exact box test of the boundary of the regularized solid - the closed
+        mesh of a tree of polytopes, with its booleans computed by Manifold
+        (:func:`csg.tree_mesh.tree_mesh`), which keeps no face shared inside the
+        solid - or None when the tree has no such mesh (a curved leaf, an open
+        mesh) or it is empty. Built once, on the first tie."""
+        from .tree_mesh import NotAMesh, tree_mesh
+        try:
+            v, f = tree_mesh(self, np.eye(4))
+        except (NotAMesh, ValueError):
+            return None
+        return MeshClassifier(v, f) if len(f) else None
 
     def voxelize(self, resolution: Any = None, **options: Any) -> iv.Voxels:
         """:func:`implicitvox.voxelize` this solid, with the same arguments

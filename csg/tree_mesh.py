@@ -98,7 +98,13 @@ def leaf_mesh(solid: Solid, matrix: np.ndarray) -> tuple[np.ndarray, np.ndarray]
 def _manifold(solid: Solid, matrix: np.ndarray):
     import manifold3d
     if isinstance(solid, Transformed):
-        return _manifold(solid.children[0], matrix @ solid.matrix)
+        child, moved = solid.children[0], matrix @ solid.matrix
+        if isinstance(child, (Union, Difference, Intersection)):
+            # a boolean in its own frame, then moved (as OpenSCAD moves its result): faces
+            # that coincide in that frame still coincide, where moving each operand's
+            # vertices first would round them apart into slivers
+            return _manifold(child, np.eye(4)).transform(np.ascontiguousarray(moved[:3, :4]))
+        return _manifold(child, moved)
     if isinstance(solid, (Union, Difference, Intersection)):
         op = {Union: manifold3d.OpType.Add, Difference: manifold3d.OpType.Subtract,
               Intersection: manifold3d.OpType.Intersect}[type(solid)]

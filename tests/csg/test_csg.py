@@ -443,3 +443,23 @@ def test_children_decided_by_another_are_skipped_and_change_no_state(monkeypatch
         assert [kid[0] for kid in classify.plan(tree)[1]] == ["exact", "function"]
     for k in (0, 2, 3):
         assert 0 < asked[k] <= exact_open[k] < len(lo)
+
+
+@pytest.mark.parametrize("turn", [0.0, 17.0])
+def test_faces_shared_inside_a_union_are_no_surface(turn):
+    """Two boxes touching on a face, and a box minus one sharing its top face, voxelize
+    as the one box they make: the shared face is inside the regularized solid (the
+    tree's mesh decides the voxels that halving leaves tied), on a lattice the face
+    lies on and, turned, across voxels."""
+    def placed(s):
+        return s.rotate((1, 2, 3), turn)
+    halves = placed(Box((1, 1, 1)) | Box((1, 1, 1)).translate((1, 0, 0)))
+    cut = placed(Box((2, 1, 1.5)) - Box((2, 1, 0.5)).translate((0, 0, 1)))
+    whole = placed(Box((2, 1, 1)))
+    bounds = ((-1.5, -1.5, -1.5), (2.5, 2.5, 2.5))
+    expected = whole.voxelize(64, bounds=bounds)
+    for solid in (halves, cut):
+        vox = solid.voxelize(64, bounds=bounds)
+        assert vox.count == expected.count
+        assert np.array_equal(vox.coords(), expected.coords())
+    assert halves.regularized_boundary is not None
