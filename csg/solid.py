@@ -34,7 +34,7 @@ import numpy as np
 import implicitvox as iv
 from implicitvox import Expr, validate, x, y, z
 
-from .classify import MeshClassifier, exact_classifier, plan, world_primitive
+from .classify import exact_classifier, plan, world_primitive
 
 __all__ = ["Solid", "Union", "Intersection", "Difference", "Complement", "Transformed",
            "ExprSolid", "Bounds", "rotation_matrix", "vector", "box_bound", "SCENE_FORMAT"]
@@ -43,6 +43,17 @@ __all__ = ["Solid", "Union", "Intersection", "Difference", "Complement", "Transf
 SCENE_FORMAT = 1
 
 Bounds = Optional[tuple[tuple[float, float, float], tuple[float, float, float]]]
+
+
+#: what builds a tree's :attr:`Solid.regularized_boundary` (the meshes and their
+#: booleans live above the solids: :mod:`csg.tree_mesh` registers it on import)
+_REGULARIZERS: list[Callable[["Solid"], Optional[Any]]] = []
+
+
+def register_regularizer(build: Callable[["Solid"], Optional[Any]]) -> None:
+    """Make ``build(solid)`` (a box test of the regularized solid's boundary, or
+    None) what :attr:`Solid.regularized_boundary` asks."""
+    _REGULARIZERS.append(build)
 
 
 class Solid:
@@ -173,15 +184,11 @@ class Solid:
     def regularized_boundary(self) -> Optional[Any]:
         """The exact box test of the boundary of the regularized solid - the closed
         mesh of a tree of polytopes, with its booleans computed by Manifold
-        (:func:`csg.tree_mesh.tree_mesh`), which keeps no face shared inside the
-        solid - or None when the tree has no such mesh (a curved leaf, an open
-        mesh) or it is empty. Built once, on the first tie."""
-        from .tree_mesh import NotAMesh, tree_mesh
-        try:
-            v, f = tree_mesh(self, np.eye(4))
-        except (NotAMesh, ValueError):
-            return None
-        return MeshClassifier(v, f) if len(f) else None
+        (:func:`csg.tree_mesh.regularized_classifier`, registered by
+        :func:`register_regularizer`), which keeps no face shared inside the solid -
+        or None when the tree has no such mesh (a curved leaf, an open mesh) or it
+        is empty. Built once, on the first tie."""
+        return None if _REGULARIZERS == [] else _REGULARIZERS[-1](self)
 
     def voxelize(self, resolution: Any = None, **options: Any) -> iv.Voxels:
         """:func:`implicitvox.voxelize` this solid, with the same arguments

@@ -29,9 +29,10 @@ import numpy as np
 from .primitives import (Box, ConvexPolyhedron, Cylinder, Ellipsoid, Polyhedron, Sphere,
                          Torus)
 from .prism import Prism
-from .solid import Difference, Intersection, Solid, Transformed, Union
+from .classify import MeshClassifier
+from .solid import Difference, Intersection, Solid, Transformed, Union, register_regularizer
 
-__all__ = ["tree_mesh", "leaf_mesh", "mesh_volume", "NotAMesh"]
+__all__ = ["tree_mesh", "leaf_mesh", "mesh_volume", "NotAMesh", "regularized_classifier"]
 
 _CURVED = (Sphere, Cylinder, Torus, Ellipsoid)
 
@@ -135,3 +136,18 @@ def tree_mesh(solid: Solid, matrix: np.ndarray) -> tuple[np.ndarray, np.ndarray]
     result = _manifold(solid, matrix).to_mesh64()
     v = np.asarray(result.vert_properties, dtype=np.float64)[:, :3]
     return v, np.asarray(result.tri_verts, dtype=np.int64).reshape(-1, 3)
+
+
+def regularized_classifier(solid: Solid):
+    """The exact box test (:class:`~csg.classify.MeshClassifier`) of the boundary of
+    the regularized ``solid``: its :func:`tree_mesh`, whose booleans keep no face
+    shared inside the solid; None where the tree has no mesh (a curved leaf, an
+    open mesh) or is empty."""
+    try:
+        v, f = tree_mesh(solid, np.eye(4))
+    except (NotAMesh, ValueError):
+        return None
+    return MeshClassifier(v, f) if len(f) else None
+
+
+register_regularizer(regularized_classifier)
