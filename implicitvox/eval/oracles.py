@@ -25,7 +25,12 @@ from ..expr.sweeps import FRAMES
 from ..interval import kernels as I
 from ..interval import rounding as R
 
-__all__ = ["Sweep", "PolarSweep", "compile_oracle"]
+__all__ = ["Sweep", "PolarSweep", "compile_oracle", "REFERENCE_DIGITS"]
+
+#: digits the exact reference keeps for a repeat's local coordinate: beyond
+#: ``10**(dps - REFERENCE_DIGITS)`` instances the reference gives no value (the
+#: instance index would eat the working precision, and the local coordinate with it)
+REFERENCE_DIGITS = 20
 
 # -- runtime forms (the tape's instruction parameters) -------------------------------
 def _columns(arrays: Sequence[Any]) -> tuple[tuple[int, ...], list[np.ndarray]]:
@@ -144,7 +149,10 @@ class Sweep(_Compiled):
             if s is None:
                 local.append(t)
                 continue
-            k = mpmath.floor(t / mpmath.mpf(s) + mpmath.mpf(0.5))
+            u = t / mpmath.mpf(s)
+            if abs(u) > mpmath.mpf(10) ** (mpmath.mp.dps - REFERENCE_DIGITS):
+                return None     # the local coordinate is beyond the working precision
+            k = mpmath.floor(u + mpmath.mpf(0.5))
             if n is not None:
                 k = min(max(k, 0), n - 1)
             local.append(t - k * mpmath.mpf(s))

@@ -89,3 +89,15 @@ def test_sweeps_compose_and_remap():
 def test_bad_sweeps(call, match):
     with pytest.raises(ValueError, match=match):
         call()
+
+
+def test_the_reference_gives_no_value_past_its_precision():
+    """Far out (3e152 over a spacing of 1.5) the instance index needs more digits than
+    the reference works with: it gives no value (the property tests then skip the
+    point) instead of a local coordinate that is all rounding (found by hypothesis:
+    the reference said 1.9e137 for a function bounded by 0.65)."""
+    from implicitvox.eval.reference import mp_evaluate
+    shape = ivx.repeat((ivx.y ** 3) ** 0.5, spacing=(None, 1.5, None))
+    far = shape.remap(x=ivx.x, y=ivx.x / -2.567437590812482e-153 - ivx.x, z=ivx.x)
+    assert mp_evaluate(far, (-0.824344379397441, 0.0, 0.0)) is None
+    assert abs(float(mp_evaluate(shape, (0.0, 3.3, 0.0))) - 0.3 ** 1.5) < 1e-15
