@@ -27,7 +27,9 @@ For every ``/usr/share/openscad/examples/**/*.scad``:
    within one voxel. ``ratio`` is output voxels over STL voxels.
 
 Each model runs in a child process with a timeout. Writes the table
-``openscad`` (the note of issue 17 quotes it).
+``openscad`` (the note of issue 17 quotes it). ``--constructs``: the same for
+one small model per construct (:data:`CONSTRUCTS`), the table
+``openscad-constructs``.
 """
 from __future__ import annotations
 
@@ -52,12 +54,73 @@ except ImportError:        # run as a script from elsewhere
 EXAMPLES = Path("/usr/share/openscad/examples")
 CACHE = Path.home() / ".cache" / "implicitvox" / "openscad"
 POINTS = 20_000
+#: ``--constructs``: one small model per construct, odd facet counts and edge cases
+#: included (an odd ``$fn`` on a full ``rotate_extrude`` found a miss), written to
+#: ``CACHE / "constructs"`` and run as the examples are (the table ``openscad-constructs``)
+CONSTRUCTS = {
+    "sphere_fn5": "sphere(r=5, $fn=5);",
+    "sphere_fn7": "sphere(r=5, $fn=7);",
+    "sphere_fa_fs": "sphere(r=7, $fa=17, $fs=1.3);",
+    "frustum_fn5": "cylinder(h=6, r1=4, r2=2, $fn=5);",
+    "cone_fn9": "cylinder(h=6, r1=4, r2=0, $fn=9);",
+    "cylinder_centered": "cylinder(h=5, r=3, center=true, $fn=11);",
+    "circle_fn7": "linear_extrude(3) circle(r=4, $fn=7);",
+    "circle_fs": "linear_extrude(1) circle(r=10, $fs=0.7, $fa=3);",
+    "twist_slices7": "linear_extrude(height=10, twist=97, slices=7) square([6,2], center=true);",
+    "twist_scale": "linear_extrude(height=8, twist=-45, scale=[0.5,1.5]) circle(r=3, $fn=9);",
+    "scale_only": "linear_extrude(height=6, scale=0.3) square(5, center=true);",
+    "twist_centered": "linear_extrude(height=3, center=true, twist=30, slices=3) "
+                      "translate([1,1]) square([3,1]);",
+    "sweep_fn7": "rotate_extrude($fn=7) translate([4,0]) circle(r=1.5, $fn=5);",
+    "sweep_partial": "rotate_extrude(angle=200, $fn=13) translate([3,1]) square([2,3]);",
+    "sweep_clockwise": "rotate_extrude(angle=-270, $fn=11) translate([3,0]) "
+                       "polygon([[0,0],[2,0],[1,3]]);",
+    "sweep_on_axis": "rotate_extrude($fn=9) polygon([[0,0],[4,0],[2,3],[0,5]]);",
+    "offset_r": "linear_extrude(2) offset(r=1, $fn=7) square([4,3]);",
+    "offset_delta": "linear_extrude(2) offset(delta=-0.7) "
+                    "polygon([[0,0],[6,0],[6,4],[3,2],[0,4]]);",
+    "offset_chamfer": "linear_extrude(2) offset(delta=1, chamfer=true) square([4,3]);",
+    "hull_3d": "hull() { sphere(2, $fn=7); translate([6,1,2]) cube(2); }",
+    "hull_2d": "linear_extrude(2) hull() { circle(2, $fn=5); translate([5,3]) circle(1, $fn=7); }",
+    "minkowski_3d": "minkowski() { cube([4,3,2]); sphere(1, $fn=7); }",
+    "minkowski_2d": "linear_extrude(1) minkowski() { square([3,2]); circle(1, $fn=5); }",
+    "resize": "resize([10,4,3]) sphere(2, $fn=9);",
+    "resize_auto": "resize([8,0,0], auto=true) cylinder(h=3, r=2, $fn=7);",
+    "projection_cut": "linear_extrude(2) projection(cut=true) "
+                      "translate([0,0,-1]) sphere(3, $fn=9);",
+    "projection": "linear_extrude(2) projection() rotate([30,40,0]) cube([4,3,2]);",
+    "text": "linear_extrude(2) text(\"Qg8\", size=6);",
+    "mirror_difference": "difference() { mirror([1,1,0]) cube([5,3,2]); "
+                         "translate([1,1,-1]) cylinder(h=4, r=0.8, $fn=7); }",
+    "shear": "multmatrix([[1,0.3,0,0],[0,1,0.2,0],[0.1,0,1,0],[0,0,0,1]]) cube([4,4,4]);",
+    "intersection": "intersection() { sphere(4, $fn=11); cube(6, center=true); }",
+    "polyhedron": "polyhedron(points=[[0,0,0],[4,0,0],[4,4,0],[0,4,0],[2,2,4]], "
+                  "faces=[[0,1,4],[1,2,4],[2,3,4],[3,0,4],[1,0,3],[2,1,3]]);",
+    "touching_faces": "union() { cube([10,10,10]); translate([10,0,0]) cube([10,10,10]); "
+                      "translate([0,10,0]) cube([20,5,10]); }",
+    "touching_turned": "rotate([10,20,30]) union() { cube([10,10,10]); "
+                       "translate([10,0,0]) cube([10,10,10]); "
+                       "translate([0,10,0]) cylinder(h=10, r=7, $fn=12); }",
+}
 
 
-def _export(scad: Path, timeout: float) -> dict:
+def _write_constructs() -> Path:
+    """The construct models as ``.scad`` files (rewritten only when changed)."""
+    root = CACHE / "constructs"
+    root.mkdir(parents=True, exist_ok=True)
+    for name, text in CONSTRUCTS.items():
+        path = root / f"{name}.scad"
+        if not path.exists() or path.read_text() != text + "\n":
+            path.write_text(text + "\n")
+            for stale in (CACHE / "constructs-out" / name).glob("*"):
+                stale.unlink()
+    return root
+
+
+def _export(scad: Path, timeout: float, root: Path = EXAMPLES, cache: Path = CACHE) -> dict:
     """The model's .csg and .stl from the real OpenSCAD (cached), with the STL's CPU time."""
-    rel = scad.relative_to(EXAMPLES).with_suffix("")
-    out = CACHE / rel
+    rel = scad.relative_to(root).with_suffix("")
+    out = cache / rel
     out.mkdir(parents=True, exist_ok=True)
     info_path = out / "export.json"
     if info_path.exists():
@@ -197,6 +260,8 @@ def main() -> None:
     parser.add_argument("--resolution", type=int, default=128)
     parser.add_argument("--timeout", type=float, default=300)
     parser.add_argument("--only", nargs="+", help="models whose path contains one of these")
+    parser.add_argument("--constructs", action="store_true",
+                        help="the small models of CONSTRUCTS instead of OpenSCAD's examples")
     parser.add_argument("--child", nargs=4, help=argparse.SUPPRESS)
     args = parser.parse_args()
     if args.child:
@@ -204,14 +269,17 @@ def main() -> None:
                                args.child[3])))
         return
     load = tables.load_average()
-    models = sorted(EXAMPLES.rglob("*.scad"))
+    root, cache, table = EXAMPLES, CACHE, "openscad"
+    if args.constructs:
+        root, cache, table = _write_constructs(), CACHE / "constructs-out", "openscad-constructs"
+    models = sorted(root.rglob("*.scad"))
     if args.only:
         models = [m for m in models if any(k in str(m) for k in args.only)]
     rows, summary = [], {"models": len(models), "3d": 0, "read": 0, "clean": 0,
                          "ratios": [], "times": []}
     for scad in models:
-        name = str(scad.relative_to(EXAMPLES).with_suffix(""))
-        info = _export(scad, args.timeout)
+        name = str(scad.relative_to(root).with_suffix(""))
+        info = _export(scad, args.timeout, root, cache)
         if not info.get("stl_ok"):
             rows.append([name, "no 3D result: " + info.get("stl_error", "?")[:70]] + ["-"] * 8)
             print(" | ".join(rows[-1]), flush=True)
@@ -254,7 +322,7 @@ def main() -> None:
               "ratio", "CPU s", "OpenSCAD STL CPU s", "true: beyond 1 voxel", "true: ratio",
               "true: CPU s"]
     if not args.only:
-        tables.write("openscad", header, rows, "python tests/benchmarks/bench_openscad.py "
+        tables.write(table, header, rows, "python tests/benchmarks/bench_openscad.py "
                      + " ".join(sys.argv[1:]), load)
 
 
