@@ -43,6 +43,7 @@ from .ellipsoid import quadratic_roots
 from .classify import Primitive
 from .euclidean import meridian, segment_distance
 from .norm import as_points, as_weights
+from .products import dot
 
 __all__ = ["Cylinder", "Frustum"]
 
@@ -112,14 +113,14 @@ class Frustum(Primitive):
 
     # -- pieces ----------------------------------------------------------------------------
     def _inside(self, y):
-        s = y @ self.a
+        s = dot(y, self.a)
         perp = y - s[:, None] * self.a             # |y|^2 - s^2 would cancel near the axis
         rho2 = np.sum(perp * perp, axis=1)
         return (s >= 0) & (s <= self.h) & (rho2 <= self.radius(s) ** 2)
 
     def _ray(self, y, d):
         """Entry and exit times of rays ``y + t d`` (NaN if they miss ``K``)."""
-        s0, ds = y @ self.a, d @ self.a
+        s0, ds = dot(y, self.a), dot(d, self.a)
         with np.errstate(divide="ignore", invalid="ignore"):
             t_a, t_b = -s0 / ds, (self.h - s0) / ds
         slab_in = np.where(ds != 0, np.minimum(t_a, t_b), np.where((s0 >= 0) & (s0 <= self.h),
@@ -127,10 +128,10 @@ class Frustum(Primitive):
         slab_out = np.where(ds != 0, np.maximum(t_a, t_b), np.where((s0 >= 0) & (s0 <= self.h),
                                                                     np.inf, np.nan))
         # rho^2 - R^2 <= 0 along the ray: A t^2 + 2 B t + C <= 0
-        Gd = d @ self.G
+        Gd = dot(d, self.G)
         A = np.sum(Gd * d, axis=1)
-        B = np.sum(Gd * y, axis=1) + d @ self.g
-        C = np.sum((y @ self.G) * y, axis=1) + 2 * (y @ self.g) + self.c0
+        B = np.sum(Gd * y, axis=1) + dot(d, self.g)
+        C = np.sum(dot(y, self.G) * y, axis=1) + 2 * dot(y, self.g) + self.c0
         with np.errstate(divide="ignore", invalid="ignore"):
             t1, t2 = quadratic_roots(np.where(A != 0, A, 1.0), B, C)
             lin = -C / (2 * B)
@@ -202,10 +203,10 @@ class Frustum(Primitive):
             P = G[np.ix_(zi, zi)] - np.outer(G[zi, k], G[k, zi]) / Gkk
             lv = gv[zi] - G[zi, k] * gv[k] / Gkk
             c1 = self.c0 - gv[k] ** 2 / Gkk
-            Pz0 = z0 @ P
-            A = np.sum((dz @ P) * dz, axis=1)
-            B = np.sum(Pz0 * dz, axis=1) + dz @ lv
-            C = np.sum(Pz0 * z0, axis=1) + 2 * (z0 @ lv) + c1
+            Pz0 = dot(z0, P)
+            A = np.sum(dot(dz, P) * dz, axis=1)
+            B = np.sum(Pz0 * dz, axis=1) + dot(dz, lv)
+            C = np.sum(Pz0 * z0, axis=1) + 2 * dot(z0, lv) + c1
             # every time the line is tangent to the (double) quadric is a candidate: a
             # tangency on the real cone, at a point of the edge, is a genuine contact
             with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
@@ -214,10 +215,10 @@ class Frustum(Primitive):
             for t1 in (np.where(A != 0, r1, lin), np.where(A != 0, r2, np.nan)):
                 t1 = np.where(t1 >= 0, t1, np.nan)
                 z = z0 + t1[:, None] * dz
-                yk = -(z @ G[zi, k] + gv[k]) / Gkk
+                yk = -(dot(z, G[zi, k]) + gv[k]) / Gkk
                 full = np.empty((n, 3))
                 full[:, i], full[:, j], full[:, k] = z[:, 0], z[:, 1], yk
-                s = full @ a
+                s = dot(full, a)
                 ok = (s >= -_TOL * h) & (s <= h * (1 + _TOL)) & self._on_edge(yk, y, w, k, t1)
                 best = np.fmin(best, np.where(ok, t1, np.inf))
         elif self.k != 0:
@@ -241,10 +242,10 @@ class Frustum(Primitive):
                 # the line crosses the cap plane at y_k = (s_cap - a_i z_i - a_j z_j) / a_k
                 def point(t):
                     z = z0 + t[:, None] * dz
-                    yk = (s_cap - z @ a[[i, j]]) / a[k]
+                    yk = (s_cap - dot(z, a[[i, j]])) / a[k]
                     return z, yk
                 zc0, ykc0 = point(np.zeros(n))
-                dyk = -(dz @ a[[i, j]]) / a[k]
+                dyk = -dot(dz, a[[i, j]]) / a[k]
                 q0 = np.zeros((n, 3))
                 q0[:, i], q0[:, j], q0[:, k] = zc0[:, 0], zc0[:, 1], ykc0
                 dq = np.zeros((n, 3))
@@ -261,8 +262,8 @@ class Frustum(Primitive):
                 best = np.fmin(best, np.where(ok, t1, np.inf))
             else:
                 # the line is parallel to the cap plane: it reaches the plane at one time
-                ds = dz @ a[[i, j]]
-                s0 = z0 @ a[[i, j]]
+                ds = dot(dz, a[[i, j]])
+                s0 = dot(z0, a[[i, j]])
                 with np.errstate(divide="ignore", invalid="ignore"):
                     t1 = (s_cap - s0) / ds
                 t1 = np.where((ds != 0) & (t1 >= 0), t1, np.nan)

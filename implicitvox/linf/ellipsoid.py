@@ -33,6 +33,7 @@ from .. import expr as ex
 
 from .classify import Primitive
 from .norm import as_points, as_weights
+from .products import dot
 
 __all__ = ["Ellipsoid", "quadratic_roots"]
 
@@ -105,7 +106,7 @@ class Ellipsoid(Primitive):
         it is one to 1e-9, which rounding near the disc can spoil), so the nearer of
         them is the distance."""
         p = as_points(points)
-        y = np.abs((p - self.center) @ self.rotation)             # local, first octant
+        y = np.abs(dot(p - self.center, self.rotation))            # local, first octant
         e = self.radii
         e2 = e * e
         inside = np.sum((y / e) ** 2, axis=1) < 1.0
@@ -145,7 +146,7 @@ class Ellipsoid(Primitive):
         w = as_weights(weights, len(p))
         y = np.ascontiguousarray((p - self.center).T)         # columns: fast row sums
         w = np.ascontiguousarray(w.T)
-        Qy = self.Q @ y
+        Qy = np.stack([dot(y.T, q) for q in self.Q])     # Q y, no BLAS
         level = y[0] * Qy[0] + y[1] * Qy[1] + y[2] * Qy[2]
         C = level - 1.0
         # Vertex contacts (outside) and corner exits (inside), 8 rays as 4 lines

@@ -20,6 +20,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from .products import dot
+
 __all__ = ["triangle_distance", "segment_distance", "meridian"]
 
 
@@ -78,6 +80,6 @@ def meridian(points: np.ndarray, centre: np.ndarray, axis: np.ndarray) -> np.nda
     ``axis``: the distance from the axis and the height along it. A solid of
     revolution's nearest surface point lies in the point's meridian half-plane."""
     q = np.asarray(points, dtype=np.float64) - centre
-    s = q @ axis
+    s = dot(q, axis)
     rho = np.linalg.norm(q - s[:, None] * axis, axis=1)
     return np.stack([rho, s], axis=1)

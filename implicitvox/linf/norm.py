@@ -19,6 +19,8 @@ from typing import Any
 
 import numpy as np
 
+from .products import dot
+
 __all__ = ["as_points", "as_weights", "support", "in_blocks", "float_bisection"]
 
 
@@ -51,7 +53,7 @@ def as_weights(weights: Any, n: int) -> np.ndarray:
 
 def support(u: np.ndarray, w: np.ndarray) -> np.ndarray:
     """``sum_i |u_i| w_i``: how far the box of half-widths ``w`` reaches along ``u``."""
-    return np.abs(u) @ np.ones(3) if w is None else np.sum(np.abs(u) * w, axis=-1)
+    return dot(np.abs(u), np.ones(3)) if w is None else np.sum(np.abs(u) * w, axis=-1)
 
 
 def in_blocks(fn, p: np.ndarray, w: np.ndarray, size: int) -> np.ndarray:

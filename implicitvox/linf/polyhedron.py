@@ -32,6 +32,7 @@ from .. import expr as ex
 from .classify import Primitive
 from .euclidean import triangle_distance as triangle_euclidean
 from .norm import as_points, as_weights, in_blocks
+from .products import dot
 from .. import batches
 
 __all__ = ["ConvexPolyhedron", "HalfSpace", "ConvexHullFaces", "convex_hull_faces",
@@ -118,7 +119,7 @@ class ConvexPolyhedron(Primitive):
         cross = np.cross(box[:, None, :], np.asarray(edges, dtype=np.float64)[None]).reshape(-1, 3)
         u = _unique_directions(np.concatenate([box, self.normals, cross]))
         self.axes = np.concatenate([u, -u])                    # (A, 3)
-        proj = self.vertices @ self.axes.T                      # (m, A)
+        proj = dot(self.vertices, self.axes.T)                     # (m, A)
         self.low = proj.min(axis=0)                             # min_P u.x per axis
         self._facets = None                                     # hull triangles, on demand
 
@@ -154,12 +155,12 @@ class ConvexPolyhedron(Primitive):
         return in_blocks(self._distance, p, w, CHUNK)
 
     def _distance(self, p: np.ndarray, w: np.ndarray) -> np.ndarray:
-        slack = self.offsets[None, :] - p @ self.normals.T              # (n, F), >= 0 inside
+        slack = self.offsets[None, :] - dot(p, self.normals.T)             # (n, F), >= 0 inside
         inside = np.all(slack >= 0, axis=1)
-        h_faces = w @ np.abs(self.normals).T
+        h_faces = dot(w, np.abs(self.normals).T)
         d_in = -np.min(slack / h_faces, axis=1)
-        h_axes = w @ np.abs(self.axes).T                                  # (n, A)
-        d_out = np.max((self.low[None, :] - p @ self.axes.T) / h_axes, axis=1)
+        h_axes = dot(w, np.abs(self.axes).T)                                 # (n, A)
+        d_out = np.max((self.low[None, :] - dot(p, self.axes.T)) / h_axes, axis=1)
         return np.where(inside, d_in, d_out)
 
     def euclidean_distance(self, points: Any) -> np.ndarray:
@@ -172,7 +173,7 @@ class ConvexPolyhedron(Primitive):
         if self._facets is None:
             from scipy.spatial import ConvexHull
             self._facets = self.vertices[ConvexHull(self.vertices).simplices]
-        excess = p @ self.normals.T - self.offsets[None, :]           # (n, F), <= 0 inside
+        excess = dot(p, self.normals.T) - self.offsets[None, :]          # (n, F), <= 0 inside
         d_in = np.max(excess, axis=1)
         out = d_in > 0
         d = d_in.copy()
@@ -213,11 +214,11 @@ class HalfSpace(Primitive):
     def distance(self, points: Any, weights: Any = None) -> np.ndarray:
         p = as_points(points)
         w = as_weights(weights, len(p))
-        return (p @ self.normal - self.offset) / (w @ np.abs(self.normal))
+        return (dot(p, self.normal) - self.offset) / dot(w, np.abs(self.normal))
 
     def euclidean_distance(self, points: Any) -> np.ndarray:
         """Signed Euclidean distance ``(n.p - d) / |n|``."""
-        return (as_points(points) @ self.normal - self.offset) / np.linalg.norm(self.normal)
+        return (dot(as_points(points), self.normal) - self.offset) / np.linalg.norm(self.normal)
 
 
 

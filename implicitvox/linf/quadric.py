@@ -42,6 +42,7 @@ from .. import expr as ex
 
 from .classify import Primitive
 from .norm import as_points, as_weights
+from .products import dot
 
 __all__ = ["Quadric"]
 
@@ -102,7 +103,7 @@ class Quadric(Primitive):
 
     def value(self, points: Any) -> np.ndarray:
         p = np.asarray(points, dtype=np.float64)
-        return np.einsum("ni,ij,nj->n", p, self.A, p) + p @ self.b + self.c
+        return np.einsum("ni,ij,nj->n", p, self.A, p) + dot(p, self.b) + self.c
 
     @property
     def expr(self) -> ex.Expr:
@@ -125,7 +126,7 @@ class Quadric(Primitive):
         w = as_weights(weights, len(p))
         A = self.A
         q0 = self.value(p)
-        g = 2 * p @ A + self.b
+        g = dot(2 * p, A) + self.b
         gw = g * w                                             # g_i w_i
         ww = {(i, j): w[:, i] * w[:, j] for i in range(3) for j in range(i, 3)}
         best = np.where(q0 == 0, 0.0, np.inf)
@@ -161,9 +162,9 @@ class Quadric(Primitive):
             Minv = np.linalg.inv(M)
             Aik = A[[j, k], i]
             S = A[i, i] - Aik @ Minv @ Aik                    # Schur complement
-            h = g[:, [j, k]] @ Minv                           # Minv g_jk (M symmetric)
+            h = dot(g[:, [j, k]], Minv)                          # Minv g_jk (M symmetric)
             a0 = q0 - 0.25 * np.sum(h * g[:, [j, k]], axis=1)
-            gi = g[:, i] - h @ Aik
+            gi = g[:, i] - dot(h, Aik)
             alpha = -0.5 * h                                  # (y_j, y_k) = alpha + beta t
             beta_unit = -(Minv @ Aik)
             a2 = S * ww[i, i]

@@ -58,6 +58,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from .products import dot
+
 __all__ = ["TorusFrame"]
 
 _TWO_PI = 2.0 * np.pi
@@ -104,7 +106,7 @@ class TorusFrame:
 
     def signed_euclidean(self, y):
         """Euclidean signed distance of ``y = x - c`` (``(..., 3)``) to the surface."""
-        z = y @ self.a
+        z = dot(y, self.a)
         perp = y - z[..., None] * self.a
         rho = np.sqrt(np.einsum("...i,...i->...", perp, perp))
         return np.hypot(rho - self.R, z) - self.r
@@ -144,7 +146,7 @@ class TorusFrame:
         value is a point of the surface."""
         y0 = p - self.c
         R2, K = self.R ** 2, self.R ** 2 - self.r ** 2
-        g = y0 @ self.a
+        g = dot(y0, self.a)
         perp0 = y0 - g[:, None] * self.a
         C = np.einsum("ij,ij->i", y0, y0)
         rho2 = np.einsum("ij,ij->i", perp0, perp0)
@@ -312,7 +314,7 @@ class TorusFrame:
         thetas, phis, owners = [], [], []
         n = len(p)
         idx = np.arange(n)
-        le1, le2 = ell @ self.e1, ell @ self.e2
+        le1, le2 = dot(ell, self.e1), dot(ell, self.e2)
         # circles c ± r a + R u(theta):  l.(c ± r a - p) + R (le1 cos + le2 sin) = 0
         base = np.arctan2(le2, le1)
         amp = self.R * np.hypot(le1, le2)
@@ -329,7 +331,7 @@ class TorusFrame:
         theta_m = np.arctan2(-self.e1[k], self.e2[k])
         for th0 in (theta_m, theta_m + np.pi):
             um = self.u(np.array(th0))
-            lu, la = ell @ um, ell @ self.a
+            lu, la = dot(ell, um), dot(ell, self.a)
             off = np.einsum("ij,ij->i", ell, self.c - p) + self.R * lu
             with np.errstate(invalid="ignore", divide="ignore"):
                 half = np.arccos(-off / (self.r * np.hypot(lu, la)))
