@@ -146,7 +146,7 @@ class Ellipsoid(Primitive):
         w = as_weights(weights, len(p))
         y = np.ascontiguousarray((p - self.center).T)         # columns: fast row sums
         w = np.ascontiguousarray(w.T)
-        Qy = np.stack([dot(y.T, q) for q in self.Q])     # Q y, no BLAS
+        Qy = dot(self.Q, y)                                   # Q y, no BLAS
         level = y[0] * Qy[0] + y[1] * Qy[1] + y[2] * Qy[2]
         C = level - 1.0
         # Vertex contacts (outside) and corner exits (inside), 8 rays as 4 lines
