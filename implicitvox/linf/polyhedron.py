@@ -157,9 +157,13 @@ class ConvexPolyhedron(Primitive):
     def _distance(self, p: np.ndarray, w: np.ndarray) -> np.ndarray:
         slack = self.offsets[None, :] - dot(p, self.normals.T)             # (n, F), >= 0 inside
         inside = np.all(slack >= 0, axis=1)
-        h_faces = dot(w, np.abs(self.normals).T)
+        # the octants of one level share their half-widths: the reach of the box
+        # along each face and axis is then one row (the same numbers, broadcast)
+        if len(w) > 1 and bool((w == w[0]).all()):
+            w = w[:1]
+        h_faces = dot(w, np.abs(self.normals).T)                             # (n or 1, F)
         d_in = -np.min(slack / h_faces, axis=1)
-        h_axes = dot(w, np.abs(self.axes).T)                                 # (n, A)
+        h_axes = dot(w, np.abs(self.axes).T)                                 # (n or 1, A)
         d_out = np.max((self.low[None, :] - dot(p, self.axes.T)) / h_axes, axis=1)
         return np.where(inside, d_in, d_out)
 
