@@ -44,12 +44,9 @@ import numpy as np
 
 import implicitvox as iv
 from implicitvox import batches
-from implicitvox.expr.shape import AMBIGUOUS, EMPTY, FULL
-from implicitvox.triangles.crossings import RayWinding
-from implicitvox.triangles.pairs import sorted_unique
-from implicitvox.triangles.ranges import buckets, expand_boxes, gather, grid_cells
-from implicitvox.triangles.tribox import Triangles
+from implicitvox.expr.shape import AMBIGUOUS, EMPTY, FULL, Octants
 from implicitvox.octree.morton import CORNERS
+from .mesh_classifier import MeshClassifier
 
 __all__ = ["plan", "exact_classifier", "world_primitive", "similarity_scale", "MeshClassifier",
            "SETTLE_DEPTH", "SUPPORT_PAD"]
@@ -122,9 +119,12 @@ def exact_classifier(tree_plan: Optional[tuple], settle: bool = False,
     if tree_plan is None:
         return None
 
-    def classify(lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+    def classify(lo: np.ndarray, hi: np.ndarray, octants: Optional[Octants] = None
+                 ) -> np.ndarray:
         lo, hi = np.asarray(lo, dtype=float), np.asarray(hi, dtype=float)
-        state = _run(tree_plan, lo, hi)
+        # boxes the voxelizer will subdivide (all but the voxels, which ``settle``):
+        # their mesh leaves remember what they found for the children
+        state = _run(tree_plan, lo, hi, None if octants is None else (octants, not settle))
         # at the voxel level an interval leaf's AMBIGUOUS (perhaps a near miss) is
         # halved too, as the voxelizer rechecks voxels with no exact test
         unsure = (state == UNKNOWN) | (state == MAYBE)
@@ -142,6 +142,7 @@ def exact_classifier(tree_plan: Optional[tuple], settle: bool = False,
                 state[tied] = boundary.classify(lo[tied], hi[tied])
         state[(state == MAYBE) | (state == UNKNOWN)] = AMBIGUOUS
         return state
+    classify.takes_octants = True
     return classify
 
 
@@ -248,7 +249,11 @@ def _support(node: tuple) -> tuple[np.ndarray, np.ndarray, int]:
     return lo - pad, hi + pad, EMPTY
 
 
-def _run(plan: tuple, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+def _run(plan: tuple, lo: np.ndarray, hi: np.ndarray, asked: Optional[tuple] = None
+         ) -> np.ndarray:
+    """The states of boxes ``[lo, hi]`` under a plan node. ``asked``: the octants the
+    boxes are and whether they will be subdivided (``(Octants, bool)``), for the mesh
+    leaves (:meth:`MeshClassifier.classify`), or None."""
     kind = plan[0]
     if kind == "function":
         flo, fhi = plan[1].interval(lo, hi)
@@ -256,12 +261,14 @@ def _run(plan: tuple, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
         state[flo > 0] = EMPTY
         state[fhi < 0] = FULL
         return state
+    if kind == "mesh" and asked is not None:
+        return plan[1].classify(lo, hi, *asked)
     if kind in ("mesh", "prism"):
         return plan[1].classify(lo, hi)
     if kind == "exact":
         return plan[1].classify_boxes(lo, hi)
     if kind == "complement":
-        s = _run(plan[1], lo, hi)
+        s = _run(plan[1], lo, hi, asked)
         return np.where(s == FULL, EMPTY, np.where(s == EMPTY, FULL, s)).astype(np.int8)
     klo, khi, koff = plan[2]
     touches = np.all((lo[None] <= khi[:, None]) & (hi[None] >= klo[:, None]), axis=2)
@@ -274,10 +281,11 @@ def _run(plan: tuple, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
     for k, kid in enumerate(plan[1]):        # each child only where its support reaches
         ask = touches[k] & open_             # and where no child decided the box already
         if ask.all():
-            states[k] = _run(kid, lo, hi)
+            states[k] = _run(kid, lo, hi, asked)
         elif ask.any():
             near = np.flatnonzero(ask)
-            states[k, near] = _run(kid, lo[near], hi[near])
+            states[k, near] = _run(kid, lo[near], hi[near],
+                                   None if asked is None else (asked[0].subset(near), asked[1]))
         open_ &= states[k] != absorbing
     out = np.full(len(lo), UNKNOWN, dtype=np.int8)
     active = states != neutral
@@ -352,69 +360,3 @@ def _settle(plan: tuple, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
         keep = (s == UNKNOWN) & ~surface[cowner]
         owner, blo, bhi = cowner[keep], clo[keep], chi[keep]
     return state
-
-
-class MeshClassifier:
-    """Exact EMPTY / FULL / AMBIGUOUS of boxes against a closed triangle mesh.
-
-    Triangles are bucketed in a uniform grid over the mesh's box, so each box
-    is tested only against the triangles near it.
-    """
-
-    def __init__(self, vertices: np.ndarray, faces: np.ndarray, flip: bool = False):
-        self.tris = Triangles(vertices[faces])
-        self.flip = flip
-        self.winding = RayWinding(self.tris)
-        self.lo = self.tris.lo.min(axis=0)
-        self.hi = self.tris.hi.max(axis=0)
-        n = len(self.tris)
-        span = np.where(self.hi > self.lo, self.hi - self.lo, 1.0)
-        self.cells = grid_cells(self.tris.lo, self.tris.hi, self.lo, span,
-                                int(np.clip(round(2 * n ** (1 / 3)), 1, 64)))
-        self.cell_size = span / self.cells
-        first = self._cell(self.tris.lo)
-        last = self._cell(self.tris.hi)
-        tri, cell = expand_boxes(first, last)
-        key = (cell[:, 0] * self.cells + cell[:, 1]) * self.cells + cell[:, 2]
-        self.cell_tris, self.cell_start = buckets(key, tri, self.cells ** 3)
-
-    def _cell(self, p: np.ndarray) -> np.ndarray:
-        """The cell of each point: ``floor((p - lo) / size)``, clipped. Every step is
-        monotone in floating point (a rounded subtraction, a rounded division by a
-        positive number, floor, clip), so a box and a triangle whose coordinate
-        ranges overlap get cell ranges that overlap: no slack is needed."""
-        c = np.floor((p - self.lo) / self.cell_size).astype(np.int64)
-        return np.clip(c, 0, self.cells - 1)
-
-    def classify(self, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
-        state = np.full(len(lo), EMPTY, dtype=np.int8)
-        near = np.flatnonzero(np.all((lo <= self.hi) & (hi >= self.lo), axis=1))
-        meets = np.zeros(len(lo), dtype=bool)
-        if len(near):
-            box, tri = self._pairs(near, lo, hi)
-            if len(box):
-                ok = self.tris.meet_boxes(tri, lo[box], hi[box])
-                meets[box[ok]] = True
-        state[meets] = AMBIGUOUS
-        rest = near[~meets[near]]
-        if len(rest):
-            # off the surface: the whole box is on the side of its centre (a box corner
-            # is exact and in the box: use it, the rounded centre could leave a thin box)
-            w = self.winding.of_boxes(lo[rest], hi[rest])
-            state[rest] = np.where(w != 0, FULL, EMPTY)
-        return state
-
-    def _pairs(self, boxes: np.ndarray, lo: np.ndarray, hi: np.ndarray):
-        """(box, triangle) candidate pairs from the cells each box covers (exactly those:
-        :meth:`_cell` is monotone, so a triangle meeting the box shares a cell with it)."""
-        first = self._cell(lo[boxes])
-        last = self._cell(hi[boxes])
-        b, cell = expand_boxes(first, last)
-        key = (cell[:, 0] * self.cells + cell[:, 1]) * self.cells + cell[:, 2]
-        pair, index = gather(self.cell_start[key], self.cell_start[key + 1] - self.cell_start[key])
-        pb, pt = b[pair], self.cell_tris[index]
-        # a triangle spanning several cells appears once per cell: keep one pair
-        if len(pb):
-            pair = sorted_unique(pb.astype(np.int64) * len(self.tris) + pt)
-            pb, pt = pair // len(self.tris), pair % len(self.tris)
-        return boxes[pb], pt

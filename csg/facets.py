@@ -10,7 +10,9 @@
 * ``rotate_extrude``: ``max(fragments(max x) * |angle| / 360, 1)`` sectors
   whose faces are planar trapezoids: the profile at the polygonal radius
   ``rho_n = (x cos phi_k + y sin phi_k) / cos(w / 2)`` of sector ``k``
-  (width ``w``, mid-angle ``phi_k``) - an exact implicit form;
+  (width ``w``, mid-angle ``phi_k``) - an exact implicit form; the reader
+  sweeps a flat profile into OpenSCAD's own mesh instead
+  (:func:`rotation_mesh_outlines`), for the exact box test of a mesh;
 * ``linear_extrude`` with twist or a non-uniform scale: ``slices`` layers
   with each side quad split into two triangles along its shorter diagonal,
   as OpenSCAD does (a mesh). Without ``slices`` in the file, the count is
@@ -41,6 +43,7 @@ from implicitvox import Expr, x, y
 __all__ = ["fragments", "helix_slices", "conical_helix_slices", "diagonal_slices",
            "extrusion_slices", "circle_points", "sphere_points", "cylinder_points",
            "polygonal_radius", "FULL_SWEEP_START", "extrusion_mesh", "extrusion_mesh_outlines",
+           "rotation_mesh_outlines", "cap_triangles",
            "MAX_FRAGMENTS", "MAX_SPHERE_POINTS"]
 
 GRID_FINE = 0.00000095367431640625
@@ -261,7 +264,6 @@ def extrusion_mesh_outlines(pieces: list, height: float, twist: float, scale: np
     two outlines of the 2D tree cross, the walls run through the crossing point as
     OpenSCAD's do.
     """
-    import mapbox_earcut
     steps = np.arange(slices + 1) / slices
     sx, sy = 1 + (scale[0] - 1) * steps, 1 + (scale[1] - 1) * steps
     turns = [_cos_sin_degrees(-twist * t) for t in steps]
@@ -294,12 +296,7 @@ def extrusion_mesh_outlines(pieces: list, height: float, twist: float, scale: np
             verts.append(layer)
             starts.append(base)
             base += len(layer)
-        flat = np.concatenate(rings)
-        ends = np.cumsum([len(r) for r in rings]).astype(np.uint32)
-        tri = mapbox_earcut.triangulate_float64(flat, ends).reshape(-1, 3).astype(np.int64)
-        a, b, c3 = flat[tri[:, 0]], flat[tri[:, 1]], flat[tri[:, 2]]
-        area = (b[:, 0] - a[:, 0]) * (c3[:, 1] - a[:, 1]) - (b[:, 1] - a[:, 1]) * (c3[:, 0] - a[:, 0])
-        tri[area < 0] = tri[area < 0][:, ::-1]                    # counter-clockwise
+        tri = cap_triangles(rings)
         # earcut's indices into the rings' points -> the mesh's bottom and top layers
         owner = np.repeat(np.arange(len(rings)), [len(r) for r in rings])
         local = np.concatenate([np.arange(len(r)) for r in rings])
@@ -308,3 +305,78 @@ def extrusion_mesh_outlines(pieces: list, height: float, twist: float, scale: np
         faces.append(bottom[tri[:, ::-1]])                         # bottom, facing down
         faces.append(upper[tri])                                   # top, facing up
     return np.concatenate(verts), np.concatenate(faces).astype(np.int64)
+
+
+def cap_triangles(rings: list) -> np.ndarray:
+    """Triangles ``(m, 3)``, counter-clockwise, of a planar region given by its outlines
+    (an outer one counter-clockwise, then its holes): indices into the outlines' points
+    concatenated. `mapbox_earcut <https://github.com/skogler/mapbox_earcut_python>`_,
+    Mapbox's ear clipping for polygons with holes; a cap is planar, so any
+    triangulation of it is the same surface."""
+    import mapbox_earcut
+    flat = np.concatenate(rings)
+    ends = np.cumsum([len(r) for r in rings]).astype(np.uint32)
+    tri = mapbox_earcut.triangulate_float64(flat, ends).reshape(-1, 3).astype(np.int64)
+    a, b, c = flat[tri[:, 0]], flat[tri[:, 1]], flat[tri[:, 2]]
+    area = (b[:, 0] - a[:, 0]) * (c[:, 1] - a[:, 1]) - (b[:, 1] - a[:, 1]) * (c[:, 0] - a[:, 0])
+    tri[area < 0] = tri[area < 0][:, ::-1]
+    return tri
+
+
+def rotation_mesh_outlines(pieces: list, angle: float, sectors: int
+                           ) -> tuple[np.ndarray, np.ndarray]:
+    """Vertices and triangles of OpenSCAD 2021.01's ``rotate_extrude`` of a 2D region
+    (its ``rotatePolygon``): one closed mesh, oriented outward. ``pieces``: the
+    region's parts ``(outer, [holes])`` in the ``(x, z)`` plane of the profile, as
+    :func:`extrusion_mesh_outlines` takes them, all on one side of the axis.
+
+    Ring ``j`` of a full sweep is the profile turned to OpenSCAD's angle
+    ``a_j = -90 + 360 j / sectors`` (a partial one: ``a_j = 90 - angle j / sectors``,
+    ``j = 0 .. sectors``), a profile point ``(px, pz)`` going to
+    ``(px sin a_j, px cos a_j, pz)`` - :data:`FULL_SWEEP_START` in the usual angle.
+    Each quad between two rings is planar (a trapezoid symmetric about its
+    sector's mid-plane), so the solid is the same as :func:`polygonal_radius`
+    describes; a partial sweep is closed by the profile, triangulated
+    (:func:`cap_triangles`), at both ends. Profile points on the axis collapse
+    their rings to a point: the triangles that degenerate there are dropped, so
+    an edge of the profile on the axis leaves no face inside the solid.
+    """
+    full = abs(angle) >= 360
+    j = np.arange(sectors if full else sectors + 1)
+    a = -90.0 + 360.0 * j / sectors if full else 90.0 - angle * j / sectors
+    cos_a, sin_a = _cos_sin_degrees(a)
+    verts, faces = [], []
+    base = 0
+    for outer, holes in pieces:
+        rings = [np.asarray(r, dtype=np.float64) for r in (outer, *holes)]
+        starts = []
+        for ring in rings:
+            k = len(ring)
+            layer = np.stack([sin_a[:, None] * ring[None, :, 0],
+                              cos_a[:, None] * ring[None, :, 0],
+                              np.broadcast_to(ring[None, :, 1], (len(j), k))],
+                             axis=-1).reshape(-1, 3)
+            jj, ii = np.meshgrid(np.arange(sectors), np.arange(k), indexing="ij")
+            jn, i1 = (jj + 1) % len(j), (ii + 1) % k
+            p, q = base + jj * k + ii, base + jj * k + i1            # ring j: i, i + 1
+            r, t = base + jn * k + ii, base + jn * k + i1            # ring j + 1: i, i + 1
+            faces.append(np.stack([np.stack([p, t, q], -1), np.stack([p, r, t], -1)],
+                                  -2).reshape(-1, 3))
+            verts.append(layer)
+            starts.append(base)
+            base += len(layer)
+        if not full:
+            tri = cap_triangles(rings)
+            owner = np.repeat(np.arange(len(rings)), [len(r) for r in rings])
+            local = np.concatenate([np.arange(len(r)) for r in rings])
+            first = np.asarray(starts)[owner] + local
+            last = first + sectors * np.array([len(r) for r in rings])[owner]
+            faces.append(first[tri])                                   # at a_0
+            faces.append(last[tri[:, ::-1]])                           # at a_sectors
+    v, f = np.concatenate(verts), np.concatenate(faces).astype(np.int64)
+    tv = v[f]
+    collapsed = (np.all(tv[:, 0] == tv[:, 1], axis=1) | np.all(tv[:, 1] == tv[:, 2], axis=1)
+                 | np.all(tv[:, 0] == tv[:, 2], axis=1))
+    f, tv = f[~collapsed], tv[~collapsed]
+    volume = np.sum(np.einsum("ij,ij->i", tv[:, 0], np.cross(tv[:, 1], tv[:, 2])))
+    return v, (f if volume > 0 else f[:, ::-1])

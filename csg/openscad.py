@@ -520,7 +520,16 @@ class _Builder:
         b = body.bounds
         max_x = max(abs(b[0][0]), abs(b[1][0])) if b is not None else 1.0
         n = max(int(fx.fragments(max_x, *self.resolution(node)) * abs(angle) / 360), 1)
-        return RotateExtrude(body, angle, sectors=n)
+        swept = RotateExtrude(body, angle, sectors=n)
+        # OpenSCAD sweeps the result of its 2D booleans (Clipper) into a mesh: so does
+        # this, for an exact box test (the sweep's function has many sectors' terms)
+        try:
+            pieces = region_pieces(body)
+        except NotFlat:
+            return swept
+        if not pieces:
+            return self.skip(node, "its 2D children leave no area")
+        return Polyhedron(*fx.rotation_mesh_outlines(pieces, angle, n))
 
     # -- hull, minkowski, resize: exact on polytopes (csg.polytopes) ----------------------
     def _polytope_children(self, node: Node, what: str) -> list[Solid]:

@@ -16,6 +16,13 @@ A shape has
   shapes whose ``classify_boxes`` may leave a box undecided (AMBIGUOUS) to
   save work on octants that will be subdivided anyway (:mod:`csg` booleans).
 
+* an exact test with the attribute ``takes_octants = True`` is called by the
+  octree with the octants too: ``test(lo, hi, octants)``, an :class:`Octants`
+  giving their level and Morton codes (the children of ``codes >> 3``) and a
+  dict that lives for the one subdivision, where the test may keep what it
+  found about a box for the box's children (:mod:`csg`'s mesh leaves keep the
+  triangles each box meets). Other callers pass only ``lo, hi``.
+
 * ``expression_is_exact`` (optional, default True) - False when ``expr``
   only bounds the solid (zero inside a polyhedron's bounding box, say) and
   the exact test alone knows the surface: such a shape can be voxelized,
@@ -25,6 +32,7 @@ A bare expression is a shape without bounds or exact test.
 """
 from __future__ import annotations
 
+from dataclasses import dataclass
 from typing import Any, Callable, Optional, Protocol, runtime_checkable
 
 import numpy as np
@@ -32,10 +40,40 @@ import numpy as np
 from .nodes import Expr
 
 __all__ = ["Shape", "EMPTY", "FULL", "AMBIGUOUS", "as_shape", "ExprShape", "exact_classifier",
-           "voxel_classifier", "expression_is_exact"]
+           "voxel_classifier", "expression_is_exact", "Octants", "takes_octants"]
 
 #: octant states
 EMPTY, FULL, AMBIGUOUS = 0, 1, 2
+
+
+@dataclass(frozen=True)
+class Octants:
+    """The octants an exact test is asked about (see the module docstring).
+
+    Attributes
+    ----------
+    level : int
+        Their octree level (0: the root).
+    codes : ndarray of uint64, (n,)
+        Their Morton codes (:mod:`implicitvox.octree.morton`), one per box; a
+        box's parent is ``codes >> 3`` at ``level - 1``.
+    run : dict
+        Scratch space for the whole subdivision (one per run and process),
+        dropped when it ends.
+    """
+
+    level: int
+    codes: np.ndarray
+    run: dict
+
+    def subset(self, which: np.ndarray) -> "Octants":
+        """The octants ``which`` (an index or mask) of these."""
+        return Octants(self.level, self.codes[which], self.run)
+
+
+def takes_octants(test: Any) -> bool:
+    """Whether an exact test wants the :class:`Octants` of its boxes."""
+    return bool(getattr(test, "takes_octants", False))
 
 
 @runtime_checkable

@@ -42,7 +42,7 @@ from ..eval.mean_value import mean_value_enclosure
 from .precision import interval_dtype, level_dtype
 from ..interval.float32 import outward_float32
 from ..eval.precision import supports_float32
-from ..expr.shape import AMBIGUOUS, EMPTY, FULL
+from ..expr.shape import AMBIGUOUS, EMPTY, FULL, Octants, takes_octants
 from .. import batches
 
 __all__ = ["subdivide", "Subdivision", "classify", "classify_children", "suspect_voxels",
@@ -101,7 +101,7 @@ def _states(flo: np.ndarray, fhi: np.ndarray) -> np.ndarray:
 
 def classify(func: Function, grid: Grid, level: int, coords: np.ndarray,
              exact: Optional[Callable[[np.ndarray, np.ndarray], np.ndarray]] = None,
-             mean_value: bool = False, dtype=None) -> np.ndarray:
+             mean_value: bool = False, dtype=None, run: Optional[dict] = None) -> np.ndarray:
     """States (int8) of octants ``coords`` at ``level``: EMPTY, FULL or AMBIGUOUS.
 
     The natural interval extension decides first; octants it leaves
@@ -110,20 +110,23 @@ def classify(func: Function, grid: Grid, level: int, coords: np.ndarray,
     box alone, not on the level or the run, so ``Voxels.refine`` matches a
     direct voxelization: the natural extension runs in the float type that
     :func:`implicitvox.octree.precision.interval_dtype` picks for the box size
-    (``dtype`` None), or in ``dtype``.
+    (``dtype`` None), or in ``dtype``. ``run``: the subdivision's scratch space,
+    for an exact test that takes the octants (:class:`~implicitvox.expr.shape.Octants`).
     """
     lo, hi = grid.octant_boxes(level, coords)
     if dtype is None:
         dtype = interval_dtype(func.tape, grid, level)
     flo, fhi = func.interval_columns(lo, hi, dtype)
     state = _states(flo, fhi)
-    return _tighten(func.tape, lo, hi, flo, fhi, state, exact, mean_value)
+    octants = None if run is None else Octants(level, _pack(coords), run)
+    return _tighten(func.tape, lo, hi, flo, fhi, state, exact, mean_value, octants)
 
 
 def _tighten(tape: Tape, lo, hi, flo: np.ndarray, fhi: np.ndarray, state: np.ndarray,
-             exact, mean_value: bool) -> np.ndarray:
+             exact, mean_value: bool, octants: Optional[Octants] = None) -> np.ndarray:
     """Settle the AMBIGUOUS states further: the mean value form (reusing the
-    natural bounds ``flo, fhi`` already computed), then the exact test."""
+    natural bounds ``flo, fhi`` already computed), then the exact test (given
+    the ``octants`` of the boxes when it takes them)."""
     if mean_value:
         amb = np.flatnonzero(state == AMBIGUOUS)
         if amb.size:
@@ -135,7 +138,10 @@ def _tighten(tape: Tape, lo, hi, flo: np.ndarray, fhi: np.ndarray, state: np.nda
         if amb.size:
             lo_arr = np.stack([c[amb] for c in lo], axis=1)
             hi_arr = np.stack([c[amb] for c in hi], axis=1)
-            state[amb] = exact(lo_arr, hi_arr)
+            if octants is not None and takes_octants(exact):
+                state[amb] = exact(lo_arr, hi_arr, octants.subset(amb))
+            else:
+                state[amb] = exact(lo_arr, hi_arr)
     return state
 
 
@@ -253,7 +259,7 @@ def prunes_at(level: int, depth: int, length: int) -> bool:
 def classify_children(tape: Tape, grid: Grid, level: int, parents: np.ndarray,
                       exact=None, mean_value: bool = False, dtype=np.float64,
                       full: bool = False, recheck: float = 0.0,
-                      pruner: Optional[Pruner] = None
+                      pruner: Optional[Pruner] = None, run: Optional[dict] = None
                       ) -> tuple[list, Optional[np.ndarray], list, int]:
     """The AMBIGUOUS children of octants at ``level`` (and the FULL ones if ``full``).
 
@@ -268,7 +274,8 @@ def classify_children(tape: Tape, grid: Grid, level: int, parents: np.ndarray,
     group's boxes; :mod:`implicitvox.eval.pruning`). Returns ``(ambiguous,
     full, suspects, classified)``: ``ambiguous`` and ``suspects`` lists of
     groups ``(codes, tape)``, ``full`` codes or None unless asked for,
-    ``classified`` the number of boxes classified.
+    ``classified`` the number of boxes classified. ``run``: the subdivision's
+    scratch space, for an exact test that takes the octants.
     """
     record = pruner is not None and bool(tape.branches) and prunes_at(level, grid.depth,
                                                                       len(tape))
@@ -280,8 +287,10 @@ def classify_children(tape: Tape, grid: Grid, level: int, parents: np.ndarray,
         if amb.size:
             # the natural bounds are known: only the boxes are rebuilt, as columns
             box_lo, box_hi = grid.octant_boxes(level + 1, _unpack(kids[amb]))
+            octants = None if run is None else Octants(level + 1, kids[amb], run)
             state[amb] = _tighten(tape, box_lo, box_hi, flo[amb].astype(np.float64),
-                                  fhi[amb].astype(np.float64), state[amb], exact, mean_value)
+                                  fhi[amb].astype(np.float64), state[amb], exact, mean_value,
+                                  octants)
     ambiguous = state == AMBIGUOUS
     suspects: list = []
 
@@ -462,6 +471,7 @@ def subdivide(func: Function, grid: Grid, *, start: Optional[tuple[int, np.ndarr
     if exact_voxels is None:
         exact_voxels = exact
     pruner = Pruner() if prune else None
+    run: dict = {}          # the exact test's scratch space for this subdivision
     base = func.tape
     # the surface voxels as parts (codes, tape valid over their leaf_level octants)
     surface: list[tuple[np.ndarray, Tape]] = []
@@ -471,7 +481,8 @@ def subdivide(func: Function, grid: Grid, *, start: Optional[tuple[int, np.ndarr
     evaluated = 0
     if start is None:
         root = np.zeros((1, 3), dtype=np.int32)
-        state = classify(func, grid, 0, root, exact_voxels if depth == 0 else exact, mean_value)
+        state = classify(func, grid, 0, root, exact_voxels if depth == 0 else exact, mean_value,
+                         run=run)
         evaluated = 1
         if state[0] == FULL and interior:
             interior_parts[0] = [_pack(root)]
@@ -511,7 +522,7 @@ def subdivide(func: Function, grid: Grid, *, start: Optional[tuple[int, np.ndarr
         ambiguous, full, suspect, classified = classify_children(
             tape, grid, level, parents, exact_voxels if level + 1 == depth else exact, mean_value,
             level_dtype(grid, level + 1) if single else np.float64, full=interior,
-            recheck=recheck, pruner=pruner)
+            recheck=recheck, pruner=pruner, run=run)
         if full is not None and len(full):
             interior_parts.setdefault(level + 1, []).append(full)
             held += len(full)

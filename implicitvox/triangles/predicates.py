@@ -34,7 +34,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["det2_sign", "orient3d_sign", "exact_integers"]
+__all__ = ["det2_sign", "orient3d_sign", "exact_integers", "FixedPlanes"]
 
 _EPS = 2.0 ** -53
 _DET2_BOUND = 4.0 * _EPS
@@ -130,6 +130,62 @@ def orient3d_sign(a: np.ndarray, b: np.ndarray, c: np.ndarray, d: np.ndarray) ->
         exact = bx * (cy * dz - cz * dy) + by * (cz * dx - cx * dz) + bz * (cx * dy - cy * dx)
         sign[unsure] = _sign_objects(exact)
     return sign
+
+
+class FixedPlanes:
+    """``orient3d_sign(a, b, c, d)`` for fixed triangles ``(a, b, c)`` (each ``(t, 3)``)
+    against many points ``d``: the triangles' 2 x 2 minors (the components of
+    ``n = (b - a) x (c - a)``) and their permanents are computed once, so a point
+    costs a difference and a dot product, ``n . (d - a)``.
+
+    That is the determinant in Shewchuk's order with the roles of the three
+    difference vectors turned (an outer factor times a minor, summed), so his
+    bound holds as it is, against the permanent ``sum_i |d - a|_i (|b_j c_l| +
+    |b_l c_j|)``: we use the same ``8e`` as :func:`orient3d_sign`. A triangle
+    whose minor products may have underflowed, and any point the float value
+    does not clear, go to :func:`orient3d_sign` itself: the sign is exact.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> a, b, c = np.zeros((1, 3)), np.array([[1.0, 0, 0]]), np.array([[0, 1.0, 0]])
+    >>> planes = FixedPlanes(a, b, c)
+    >>> planes.sign(np.array([0, 0, 0]), np.array([[0, 0, 2.0], [5, 7, 0], [0, 0, -1]])).tolist()
+    [1, 0, -1]
+    """
+
+    def __init__(self, a: np.ndarray, b: np.ndarray, c: np.ndarray):
+        self.a, self.b, self.c = a, b, c
+        with np.errstate(all="ignore"):
+            bx, by, bz = (b[:, i] - a[:, i] for i in range(3))
+            cx, cy, cz = (c[:, i] - a[:, i] for i in range(3))
+            pairs = ((by, cz), (bz, cy), (bz, cx), (bx, cz), (bx, cy), (by, cx))
+            p1, p2, p3, p4, p5, p6 = (u * v for u, v in pairs)
+            self.normal = np.stack([p1 - p2, p3 - p4, p5 - p6], axis=1)
+            self.weight = np.stack([np.abs(p1) + np.abs(p2), np.abs(p3) + np.abs(p4),
+                                    np.abs(p5) + np.abs(p6)], axis=1)
+            ok = np.all(np.isfinite(self.weight), axis=1)
+            for (u, v), prod in zip(pairs, (p1, p2, p3, p4, p5, p6)):
+                ok &= (np.abs(prod) >= _NORMAL) | (u == 0) | (v == 0)
+        self.filtered = ok
+
+    def sign(self, which: np.ndarray, d: np.ndarray) -> np.ndarray:
+        """Sign of ``orient3d(a[which], b[which], c[which], d)`` per row, exactly."""
+        a = self.a[which]
+        n, w = self.normal[which], self.weight[which]
+        with np.errstate(all="ignore"):
+            dx, dy, dz = d[:, 0] - a[:, 0], d[:, 1] - a[:, 1], d[:, 2] - a[:, 2]
+            det = n[:, 0] * dx + n[:, 1] * dy + n[:, 2] * dz
+            bound = _DET3_BOUND * (w[:, 0] * np.abs(dx) + w[:, 1] * np.abs(dy)
+                                   + w[:, 2] * np.abs(dz))
+            sure = (np.abs(det) > bound) & (bound > _TINY) & np.isfinite(bound) \
+                & self.filtered[which]
+            sign = np.sign(det).astype(np.int8)
+        unsure = np.flatnonzero(~sure)
+        if len(unsure):
+            rows = which[unsure]
+            sign[unsure] = orient3d_sign(self.a[rows], self.b[rows], self.c[rows], d[unsure])
+        return sign
 
 
 def _columns(v):

@@ -37,11 +37,12 @@ Examples
 """
 from __future__ import annotations
 
+import functools
 from typing import Optional
 
 import numpy as np
 
-from .predicates import det2_sign, orient3d_sign
+from .predicates import FixedPlanes, det2_sign
 from ..interval.rounding import down, up
 
 __all__ = ["Triangles", "vertex_in_box"]
@@ -125,6 +126,27 @@ class Triangles:
         meets[undecided] = self.edge_stage(tri[undecided], lo[undecided], hi[undecided])
         return meets
 
+    @functools.cached_property
+    def planes(self) -> FixedPlanes:
+        """The triangles' planes, for ``orient3d`` against many points (built once)."""
+        return FixedPlanes(self.v[:, 0], self.v[:, 1], self.v[:, 2])
+
+    def plane_sides(self, tri: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+        """Where each closed box ``[lo, hi]`` lies against the plane of triangle
+        ``tri``: ``1`` strictly on the side its normal ``(v1 - v0) x (v2 - v0)``
+        points to, ``-1`` strictly on the other, ``0`` where the box meets the
+        plane (a degenerate triangle's "plane" is everywhere: 0). Exact: the
+        ``orient3d`` signs of the box corners least and greatest along the normal.
+        """
+        positive = self.normal_sign[tri] >= 0
+        cmin = np.where(positive, lo, hi)
+        side = (self.planes.sign(tri, cmin) > 0).astype(np.int8)
+        rest = np.flatnonzero(side == 0)
+        cmax = np.where(positive[rest], hi[rest], lo[rest])
+        below = self.planes.sign(tri[rest], cmax) < 0
+        side[rest[below]] = -1
+        return side
+
     def grown(self, tri, lo, hi):
         """Boxes ``[lo, hi]`` grown by the dilation of triangles ``tri`` (rounded
         outward): a box meets a grown triangle iff the grown box meets it."""
@@ -145,7 +167,7 @@ class Triangles:
         alive = np.flatnonzero(~meets)
         v, lo, hi = self.v[tri[alive]], lo[alive], hi[alive]
         sign = self.normal_sign[tri[alive]]
-        keep = ~_plane_separates(v, sign, lo, hi)
+        keep = self.plane_sides(tri[alive], lo, hi) == 0
         axis = self.axis[tri[alive]]
         for i, (j, l) in enumerate(_PLANES):
             cand = np.flatnonzero(keep & (axis == i))
@@ -185,16 +207,6 @@ def vertex_in_box(v: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
     return inside
 
 
-def _plane_separates(v, sign, lo, hi) -> np.ndarray:
-    """The box lies strictly on one side of the triangle's plane."""
-    positive = sign >= 0
-    cmin = np.where(positive, lo, hi)
-    above = orient3d_sign(v[:, 0], v[:, 1], v[:, 2], cmin) > 0
-    rest = np.flatnonzero(~above)
-    cmax = np.where(positive[rest], hi[rest], lo[rest])
-    below = orient3d_sign(v[rest, 0], v[rest, 1], v[rest, 2], cmax) < 0
-    above[rest[below]] = True
-    return above
 
 
 def _shadow_inside(v, n, lo, hi, j, l) -> np.ndarray:

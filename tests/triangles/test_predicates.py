@@ -8,7 +8,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from implicitvox.triangles.predicates import det2_sign, exact_integers, orient3d_sign
+from implicitvox.triangles.predicates import FixedPlanes, det2_sign, exact_integers, orient3d_sign
 
 
 def _sign(v: Fraction) -> int:
@@ -77,6 +77,37 @@ def test_orient3d_nearly_coplanar_matches_fractions():
     want = [orient3d_exact(a[i], b[i], c[i], d[i]) for i in range(n)]
     assert got.tolist() == want
     assert 0 in want and 1 in want and -1 in want
+
+
+def test_fixed_planes_match_fractions_nearly_coplanar():
+    """orient3d against planes whose minors were computed once: the same exact signs,
+    each plane asked about many points (near it, on it, in the hard cases)."""
+    rng = np.random.default_rng(13)
+    n = 600
+    a, b, _ = nearly_collinear(rng, n, 3)
+    c = rng.uniform(-1, 1, (n, 3))
+    exact = rng.random(n) < 0.3
+    for m in (a, b, c):
+        m[exact] = rng.integers(-1000, 1000, (exact.sum(), 3))
+    planes = FixedPlanes(a, b, c)
+    which = rng.integers(0, n, 3000)
+    s, t = rng.uniform(-1, 2, (3000, 1)), rng.uniform(-1, 2, (3000, 1))
+    s[exact[which]] = rng.integers(-8, 16, (exact[which].sum(), 1)) / 8
+    t[exact[which]] = rng.integers(-8, 16, (exact[which].sum(), 1)) / 8
+    d = a[which] + s * (b[which] - a[which]) + t * (c[which] - a[which])
+    d = np.where(rng.random((3000, 3)) < 0.3, np.nextafter(d, np.inf), d)
+    got = planes.sign(which, d)
+    want = [orient3d_exact(a[k], b[k], c[k], d[i]) for i, k in enumerate(which)]
+    assert got.tolist() == want
+    assert 0 in want and 1 in want and -1 in want
+
+
+@settings(max_examples=300)
+@given(st.lists(tiny_or_huge, min_size=12, max_size=12))
+def test_fixed_planes_any_floats(v):
+    a, b, c, d = (np.array([v[3 * i:3 * i + 3]]) for i in range(4))
+    got = int(FixedPlanes(a, b, c).sign(np.array([0]), d)[0])
+    assert got == orient3d_exact(a[0], b[0], c[0], d[0])
 
 
 @settings(max_examples=300)

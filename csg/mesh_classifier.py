@@ -1,0 +1,273 @@
+"""Exact EMPTY / FULL / AMBIGUOUS of boxes against a closed triangle mesh.
+
+A box is AMBIGUOUS iff a triangle meets the closed box (the exact test of
+:class:`implicitvox.triangles.tribox.Triangles`), else FULL or EMPTY by the
+winding number at a corner (:class:`implicitvox.triangles.crossings.RayWinding`).
+Asked about boxes cold, the leaf tests each box against the triangles bucketed
+near it in a uniform grid.
+
+Asked by the octree (with the boxes' :class:`~implicitvox.expr.shape.Octants`),
+it remembers, for each box it found AMBIGUOUS and the octree will subdivide,
+the triangles that meet it (:class:`BoxMemory`, kept in the run's scratch
+space and dropped as the children are asked); the children are tested against
+those only - a superset of the triangles that meet a child, so the answer is
+the same. A box met by one triangle ``T`` alone of a closed mesh needs less:
+
+* ``T``'s edges are shared with other triangles (the mesh is closed), and none
+  of those meets the box, so no edge of ``T`` does: ``T`` crosses the box
+  whole, and within the box ``T`` is its plane;
+* so a sub-box meets the surface iff it meets ``T``'s plane - two ``orient3d``
+  signs at the sub-box's corners least and greatest along the normal
+  (:meth:`implicitvox.triangles.tribox.Triangles.plane_sides`), exactly what the full
+  test would answer;
+* and a sub-box off the plane lies in one of the two halves of the box the
+  plane leaves, each connected and off the surface, so its winding number is
+  that half's: asked once, at a corner of the box strictly on that side, and
+  inherited by every box below.
+
+So once a region of the surface is one triangle per box - the deep levels,
+nearly everywhere - a box costs two signs and no winding query.
+"""
+from __future__ import annotations
+
+from typing import Optional
+
+import numpy as np
+
+from implicitvox.expr.shape import AMBIGUOUS, EMPTY, FULL, Octants
+from implicitvox.triangles.crossings import RayWinding
+from implicitvox.triangles.pairs import sorted_unique
+from implicitvox.triangles.ranges import buckets, expand_boxes, gather, grid_cells
+from implicitvox.triangles.tribox import Triangles
+
+__all__ = ["MeshClassifier", "BoxMemory", "edges_shared"]
+
+
+def edges_shared(vertices: np.ndarray, faces: np.ndarray) -> bool:
+    """Whether every edge of the mesh (between two distinct points, vertices merged
+    by their coordinates) lies on two face slots at least: no boundary edge, so
+    each point of a triangle's edge lies on another triangle too."""
+    v = np.asarray(vertices, dtype=np.float64)[np.asarray(faces)].reshape(-1, 3) + 0.0
+    _, point = np.unique(v, axis=0, return_inverse=True)
+    point = point.reshape(-1, 3)
+    a = point.ravel()
+    b = np.roll(point, -1, axis=1).ravel()
+    real = a != b
+    lo, hi = np.minimum(a, b)[real], np.maximum(a, b)[real]
+    _, count = np.unique(lo.astype(np.int64) * (int(point.max(initial=0)) + 1) + hi,
+                         return_counts=True)
+    return bool(np.all(count >= 2))
+
+
+class BoxMemory:
+    """What a mesh leaf found on the boxes it was asked about, for their children:
+    per level, chunks of boxes (sorted Morton codes) each with its single
+    triangle and the winding numbers of the two sides of its plane, or with the
+    list of triangles that meet it. A box's entry goes when its children are
+    asked (all eight in one call); what no child asks for goes with the run."""
+
+    def __init__(self) -> None:
+        self._levels: dict[int, list[dict]] = {}
+
+    def put(self, level: int, codes: np.ndarray, single: np.ndarray, above: np.ndarray,
+            below: np.ndarray, owner: np.ndarray, tris: np.ndarray) -> None:
+        """Remember boxes ``codes`` at ``level``: ``single`` their one triangle (or -1),
+        ``above``/``below`` the winding numbers of its plane's sides, and the pairs
+        ``(owner, tris)`` (box index, triangle) of the boxes with ``single`` -1."""
+        if not len(codes):
+            return
+        order = np.argsort(codes, kind="stable")
+        rank = np.empty(len(codes), dtype=np.int64)
+        rank[order] = np.arange(len(codes))
+        pair_order = np.argsort(rank[owner], kind="stable")
+        counts = np.bincount(rank[owner], minlength=len(codes))
+        starts = np.concatenate([[0], np.cumsum(counts)[:-1]])
+        self._levels.setdefault(level, []).append({
+            "codes": codes[order], "single": single[order], "above": above[order],
+            "below": below[order], "start": starts, "count": counts,
+            "tris": tris[pair_order], "alive": np.ones(len(codes), dtype=bool)})
+
+    def take(self, level: int, codes: np.ndarray):
+        """The entries of boxes ``codes`` at ``level``, removed: ``(found, single,
+        above, below, owner, tris)`` - per code whether it was remembered, its
+        single triangle (-1: a list), the sides' winding numbers, and the pairs
+        ``(owner, tris)`` of the listed triangles (owner: index into ``codes``)."""
+        n = len(codes)
+        found = np.zeros(n, dtype=bool)
+        single = np.full(n, -1, dtype=np.int64)
+        above = np.zeros(n, dtype=np.int64)
+        below = np.zeros(n, dtype=np.int64)
+        owners, tris = [], []
+        chunks = self._levels.get(level, [])
+        for chunk in chunks:
+            keys = chunk["codes"]
+            pos = np.minimum(np.searchsorted(keys, codes), len(keys) - 1)
+            hit = np.flatnonzero((keys[pos] == codes) & chunk["alive"][pos] & ~found)
+            if not len(hit):
+                continue
+            row = pos[hit]
+            found[hit] = True
+            single[hit], above[hit], below[hit] = (chunk["single"][row], chunk["above"][row],
+                                                   chunk["below"][row])
+            listed = single[hit] < 0
+            owner, index = gather(chunk["start"][row[listed]], chunk["count"][row[listed]])
+            owners.append(hit[listed][owner])
+            tris.append(chunk["tris"][index])
+            chunk["alive"][row] = False
+        self._levels[level] = [c for c in chunks if c["alive"].any()]
+        if not self._levels[level]:
+            del self._levels[level]
+        empty = np.zeros(0, dtype=np.int64)
+        return (found, single, above, below,
+                np.concatenate(owners) if owners else empty,
+                np.concatenate(tris) if tris else empty)
+
+    def __len__(self) -> int:
+        return sum(int(c["alive"].sum()) for chunks in self._levels.values() for c in chunks)
+
+
+class MeshClassifier:
+    """Exact EMPTY / FULL / AMBIGUOUS of boxes against a closed triangle mesh (see
+    the module docstring).
+
+    Triangles are bucketed in a uniform grid over the mesh's box, so each box
+    asked cold is tested only against the triangles near it.
+    """
+
+    def __init__(self, vertices: np.ndarray, faces: np.ndarray, flip: bool = False):
+        self.tris = Triangles(vertices[faces])
+        self.flip = flip
+        self.winding = RayWinding(self.tris)
+        #: closed (every edge shared): a box met by one triangle is cut by its plane
+        self.closed = edges_shared(vertices, faces)
+        self.lo = self.tris.lo.min(axis=0)
+        self.hi = self.tris.hi.max(axis=0)
+        n = len(self.tris)
+        span = np.where(self.hi > self.lo, self.hi - self.lo, 1.0)
+        self.cells = grid_cells(self.tris.lo, self.tris.hi, self.lo, span,
+                                int(np.clip(round(2 * n ** (1 / 3)), 1, 64)))
+        self.cell_size = span / self.cells
+        first = self._cell(self.tris.lo)
+        last = self._cell(self.tris.hi)
+        tri, cell = expand_boxes(first, last)
+        key = (cell[:, 0] * self.cells + cell[:, 1]) * self.cells + cell[:, 2]
+        self.cell_tris, self.cell_start = buckets(key, tri, self.cells ** 3)
+
+    def _cell(self, p: np.ndarray) -> np.ndarray:
+        """The cell of each point: ``floor((p - lo) / size)``, clipped. Every step is
+        monotone in floating point (a rounded subtraction, a rounded division by a
+        positive number, floor, clip), so a box and a triangle whose coordinate
+        ranges overlap get cell ranges that overlap: no slack is needed."""
+        c = np.floor((p - self.lo) / self.cell_size).astype(np.int64)
+        return np.clip(c, 0, self.cells - 1)
+
+    def classify(self, lo: np.ndarray, hi: np.ndarray, octants: Optional[Octants] = None,
+                 remember: bool = False) -> np.ndarray:
+        """States (int8) of closed boxes ``[lo, hi]`` (n, 3).
+
+        With ``octants`` (the boxes' place in the octree), the boxes whose parents
+        this leaf remembered are tested against what it found there; with
+        ``remember``, what it finds on these boxes is kept for their children.
+        """
+        state = np.full(len(lo), EMPTY, dtype=np.int8)
+        near = np.flatnonzero(np.all((lo <= self.hi) & (hi >= self.lo), axis=1))
+        if not len(near):
+            return state
+        blo, bhi = lo[near], hi[near]
+        n = len(near)
+        memory = None
+        if octants is not None:
+            memory = octants.run.setdefault(("mesh", id(self)), BoxMemory())
+            codes = octants.codes[near]
+            found, single, above, below, mb, mt = memory.take(octants.level - 1, codes >> 3)
+        else:
+            found = np.zeros(n, dtype=bool)
+            single = np.full(n, -1, dtype=np.int64)
+            above = below = np.zeros(n, dtype=np.int64)
+            mb = mt = np.zeros(0, dtype=np.int64)
+        sub = np.zeros(n, dtype=np.int8)
+        # boxes in a parent met by one triangle: its plane decides
+        one = np.flatnonzero(single >= 0)
+        if len(one):
+            t = single[one]
+            side = self.tris.plane_sides(t, blo[one], bhi[one])
+            w = np.where(side > 0, above[one], below[one])
+            sub[one] = np.where(side == 0, AMBIGUOUS, np.where(w != 0, FULL, EMPTY))
+        # the others: against their parents' triangles, or cold against the grid's
+        cold = np.flatnonzero(~found)
+        fb, ft = self._pairs(cold, blo, bhi)
+        pb, pt = np.concatenate([mb, fb]), np.concatenate([mt, ft])
+        ok = self.tris.meet_boxes(pt, blo[pb], bhi[pb]) if len(pb) else np.zeros(0, dtype=bool)
+        met_by = np.bincount(pb[ok], minlength=n)
+        tested = single < 0
+        sub[tested & (met_by > 0)] = AMBIGUOUS
+        off = np.flatnonzero(tested & (met_by == 0))
+        if len(off):
+            # off the surface: the whole box is on the side of its corner (exact, in the box)
+            w = self.winding.of_boxes(blo[off], bhi[off])
+            sub[off] = np.where(w != 0, FULL, EMPTY)
+        state[near] = sub
+        if memory is not None and remember:
+            self._remember(memory, octants.level, codes, sub, single, above, below,
+                           blo, bhi, pb[ok], pt[ok], met_by)
+        return state
+
+    def _remember(self, memory: BoxMemory, level: int, codes: np.ndarray, sub: np.ndarray,
+                  single: np.ndarray, above: np.ndarray, below: np.ndarray, blo: np.ndarray,
+                  bhi: np.ndarray, pb: np.ndarray, pt: np.ndarray, met_by: np.ndarray) -> None:
+        """Keep the AMBIGUOUS boxes' triangles for their children: a box in a
+        one-triangle parent inherits its entry; a box now met by one triangle of a
+        closed mesh gets the winding numbers of its plane's two sides."""
+        amb = sub == AMBIGUOUS
+        single, above, below = single.copy(), above.copy(), below.copy()
+        fresh = amb & (single < 0) & (met_by == 1) & self.closed
+        if fresh.any():
+            which = np.flatnonzero(fresh)
+            first = np.full(len(sub), -1, dtype=np.int64)
+            first[pb[::-1]] = pt[::-1]
+            t = first[which]
+            t_ok = np.any(self.tris.normal_sign[t] != 0, axis=1)
+            which, t = which[t_ok], t[t_ok]
+            above[which], below[which] = self._sides(t, blo[which], bhi[which])
+            single[which] = t
+        listed = amb & (single < 0)
+        keep_pair = listed[pb]
+        rows = np.flatnonzero(amb)
+        index = np.full(len(sub), -1, dtype=np.int64)
+        index[rows] = np.arange(len(rows))
+        memory.put(level, codes[rows], single[rows], above[rows], below[rows],
+                   index[pb[keep_pair]], pt[keep_pair])
+
+    def _sides(self, t: np.ndarray, lo: np.ndarray, hi: np.ndarray):
+        """Winding numbers of the parts of boxes ``[lo, hi]`` strictly above and below
+        the plane of their one triangle ``t``: at the box corner greatest (least)
+        along the normal, where that corner is off the plane (else no sub-box lies
+        on that side, and 0 is never read)."""
+        positive = self.tris.normal_sign[t] >= 0
+        above = np.zeros(len(t), dtype=np.int64)
+        below = np.zeros(len(t), dtype=np.int64)
+        for corner, want, out in ((np.where(positive, hi, lo), 1, above),
+                                  (np.where(positive, lo, hi), -1, below)):
+            # a corner is a box of no extent: its side of the plane
+            side = self.tris.plane_sides(t, corner, corner)
+            strict = np.flatnonzero(side == want)
+            if len(strict):
+                out[strict] = self.winding(corner[strict])
+        return above, below
+
+    def _pairs(self, boxes: np.ndarray, lo: np.ndarray, hi: np.ndarray):
+        """(box, triangle) candidate pairs from the cells each box covers (exactly those:
+        :meth:`_cell` is monotone, so a triangle meeting the box shares a cell with it)."""
+        if not len(boxes):
+            return np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64)
+        first = self._cell(lo[boxes])
+        last = self._cell(hi[boxes])
+        b, cell = expand_boxes(first, last)
+        key = (cell[:, 0] * self.cells + cell[:, 1]) * self.cells + cell[:, 2]
+        pair, index = gather(self.cell_start[key], self.cell_start[key + 1] - self.cell_start[key])
+        pb, pt = b[pair], self.cell_tris[index]
+        # a triangle spanning several cells appears once per cell: keep one pair
+        if len(pb):
+            pair = sorted_unique(pb.astype(np.int64) * len(self.tris) + pt)
+            pb, pt = pair // len(self.tris), pair % len(self.tris)
+        return boxes[pb].astype(np.int64), pt.astype(np.int64)
