@@ -121,6 +121,10 @@ class ConvexPolyhedron(Primitive):
         self.axes = np.concatenate([u, -u])                    # (A, 3)
         proj = dot(self.vertices, self.axes.T)                     # (m, A)
         self.low = proj.min(axis=0)                             # min_P u.x per axis
+        #: the axes without their opposites, and the two rows of ``low``: ``-u . p`` is
+        #: ``u . p`` negated, exactly (rounding to nearest is symmetric)
+        self.half_axes = u
+        self.low_plus, self.low_minus = self.low[:len(u)], self.low[len(u):]
         self._facets = None                                     # hull triangles, on demand
 
     @classmethod
@@ -159,13 +163,22 @@ class ConvexPolyhedron(Primitive):
         inside = np.all(slack >= 0, axis=1)
         # the octants of one level share their half-widths: the reach of the box
         # along each face and axis is then one row (the same numbers, broadcast)
-        if len(w) > 1 and bool((w == w[0]).all()):
+        shared = len(w) > 1 and bool((w == w[0]).all())
+        if shared:
             w = w[:1]
-        h_faces = dot(w, np.abs(self.normals).T)                             # (n or 1, F)
-        d_in = -np.min(slack / h_faces, axis=1)
-        h_axes = dot(w, np.abs(self.axes).T)                                 # (n or 1, A)
-        d_out = np.max((self.low[None, :] - dot(p, self.axes.T)) / h_axes, axis=1)
-        return np.where(inside, d_in, d_out)
+        out = np.empty(len(p))
+        rows = np.flatnonzero(inside)
+        if len(rows):
+            h_faces = dot(w if shared else w[rows], np.abs(self.normals).T)  # (n or 1, F)
+            out[rows] = -np.min(slack[rows] / h_faces, axis=1)
+        rows = np.flatnonzero(~inside)
+        if len(rows):
+            # each axis u and its opposite -u at once: low_u - u.p and low_-u + u.p
+            h_axes = dot(w if shared else w[rows], np.abs(self.half_axes).T)  # (n or 1, U)
+            q = dot(p[rows], self.half_axes.T)                                # (n, U)
+            out[rows] = np.maximum(np.max((self.low_plus[None, :] - q) / h_axes, axis=1),
+                                   np.max((self.low_minus[None, :] + q) / h_axes, axis=1))
+        return out
 
     def euclidean_distance(self, points: Any) -> np.ndarray:
         """Signed Euclidean distance: inside, to the nearest face plane (exact for a
