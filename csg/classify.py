@@ -46,7 +46,7 @@ import implicitvox as iv
 from implicitvox import batches
 from implicitvox.expr.shape import AMBIGUOUS, EMPTY, FULL, Octants
 from implicitvox.octree.morton import CORNERS
-from .mesh_classifier import MeshClassifier
+from .mesh_classifier import MeshClassifier, forget_decided
 
 __all__ = ["plan", "exact_classifier", "world_primitive", "similarity_scale", "MeshClassifier",
            "SETTLE_DEPTH", "SUPPORT_PAD"]
@@ -141,6 +141,9 @@ def exact_classifier(tree_plan: Optional[tuple], settle: bool = False,
             if boundary is not None:
                 state[tied] = boundary.classify(lo[tied], hi[tied])
         state[(state == MAYBE) | (state == UNKNOWN)] = AMBIGUOUS
+        if octants is not None and not settle:
+            # the boxes the tree decided will not be subdivided: their leaves' memory goes
+            forget_decided(octants.run, octants, np.flatnonzero(state != AMBIGUOUS))
         return state
     classify.takes_octants = True
     return classify

@@ -26,7 +26,12 @@ the same. A box met by one triangle ``T`` alone of a closed mesh needs less:
   inherited by every box below.
 
 So once a region of the surface is one triangle per box - the deep levels,
-nearly everywhere - a box costs two signs and no winding query.
+nearly everywhere - a box costs two signs and no winding query. A box no
+triangle meets keeps its winding number for its children (in a CSG tree the
+octree subdivides it where another leaf's surface passes), so they need no
+test at all; a box the whole tree decided is forgotten at once
+(:func:`forget_decided`), so the memory holds only octants still to be
+subdivided.
 """
 from __future__ import annotations
 
@@ -40,7 +45,11 @@ from implicitvox.triangles.pairs import sorted_unique
 from implicitvox.triangles.ranges import buckets, expand_boxes, gather, grid_cells
 from implicitvox.triangles.tribox import Triangles
 
-__all__ = ["MeshClassifier", "BoxMemory", "edges_shared"]
+__all__ = ["MeshClassifier", "BoxMemory", "edges_shared", "forget_decided", "LISTED", "OFF"]
+
+#: a remembered box's ``single`` when it holds no one triangle: its triangles are
+#: listed (LISTED), or none meets it and ``above`` holds its winding number (OFF)
+LISTED, OFF = -1, -2
 
 
 def edges_shared(vertices: np.ndarray, faces: np.ndarray) -> bool:
@@ -63,8 +72,10 @@ class BoxMemory:
     """What a mesh leaf found on the boxes it was asked about, for their children:
     per level, chunks of boxes (sorted Morton codes) each with its single
     triangle and the winding numbers of the two sides of its plane, or with the
-    list of triangles that meet it. A box's entry goes when its children are
-    asked (all eight in one call); what no child asks for goes with the run."""
+    list of triangles that meet it (:data:`LISTED`), or with the winding number
+    of a box no triangle meets (:data:`OFF`). A box's entry goes when its
+    children are asked (all eight in one call), or when the tree decides the box
+    (:func:`forget_decided`: it will not be subdivided)."""
 
     def __init__(self) -> None:
         self._levels: dict[int, list[dict]] = {}
@@ -72,8 +83,9 @@ class BoxMemory:
     def put(self, level: int, codes: np.ndarray, single: np.ndarray, above: np.ndarray,
             below: np.ndarray, owner: np.ndarray, tris: np.ndarray) -> None:
         """Remember boxes ``codes`` at ``level``: ``single`` their one triangle (or -1),
-        ``above``/``below`` the winding numbers of its plane's sides, and the pairs
-        ``(owner, tris)`` (box index, triangle) of the boxes with ``single`` -1."""
+        ``above``/``below`` the winding numbers of its plane's sides (an OFF box's
+        own in ``above``), and the pairs ``(owner, tris)`` (box index, triangle) of
+        the boxes with ``single`` :data:`LISTED`."""
         if not len(codes):
             return
         order = np.argsort(codes, kind="stable")
@@ -90,7 +102,8 @@ class BoxMemory:
     def take(self, level: int, codes: np.ndarray):
         """The entries of boxes ``codes`` at ``level``, removed: ``(found, single,
         above, below, owner, tris)`` - per code whether it was remembered, its
-        single triangle (-1: a list), the sides' winding numbers, and the pairs
+        single triangle (or :data:`LISTED`, :data:`OFF`), the sides' winding numbers
+        (an OFF box's in ``above``), and the pairs
         ``(owner, tris)`` of the listed triangles (owner: index into ``codes``)."""
         n = len(codes)
         found = np.zeros(n, dtype=bool)
@@ -109,21 +122,44 @@ class BoxMemory:
             found[hit] = True
             single[hit], above[hit], below[hit] = (chunk["single"][row], chunk["above"][row],
                                                    chunk["below"][row])
-            listed = single[hit] < 0
+            listed = single[hit] == LISTED
             owner, index = gather(chunk["start"][row[listed]], chunk["count"][row[listed]])
             owners.append(hit[listed][owner])
             tris.append(chunk["tris"][index])
             chunk["alive"][row] = False
-        self._levels[level] = [c for c in chunks if c["alive"].any()]
-        if not self._levels[level]:
-            del self._levels[level]
+        self._prune(level)
         empty = np.zeros(0, dtype=np.int64)
         return (found, single, above, below,
                 np.concatenate(owners) if owners else empty,
                 np.concatenate(tris) if tris else empty)
 
+    def forget(self, level: int, codes: np.ndarray) -> None:
+        """Drop the entries of boxes ``codes`` at ``level``, if any."""
+        for chunk in self._levels.get(level, []):
+            keys = chunk["codes"]
+            pos = np.minimum(np.searchsorted(keys, codes), len(keys) - 1)
+            chunk["alive"][pos[keys[pos] == codes]] = False
+        self._prune(level)
+
+    def _prune(self, level: int) -> None:
+        if level in self._levels:
+            self._levels[level] = [c for c in self._levels[level] if c["alive"].any()]
+            if not self._levels[level]:
+                del self._levels[level]
+
     def __len__(self) -> int:
         return sum(int(c["alive"].sum()) for chunks in self._levels.values() for c in chunks)
+
+
+def forget_decided(run: dict, octants: Octants, decided: np.ndarray) -> None:
+    """Tell every mesh leaf's memory in ``run`` that the tree decided the boxes
+    ``decided`` (indices into ``octants``): no child of theirs will be asked."""
+    if not len(decided):
+        return
+    codes = octants.codes[decided]
+    for memory in run.values():
+        if isinstance(memory, BoxMemory):
+            memory.forget(octants.level, codes)
 
 
 class MeshClassifier:
@@ -186,12 +222,18 @@ class MeshClassifier:
             above = below = np.zeros(n, dtype=np.int64)
             mb = mt = np.zeros(0, dtype=np.int64)
         sub = np.zeros(n, dtype=np.int8)
+        wind = np.zeros(n, dtype=np.int64)           # the winding number off the surface
+        # boxes in a parent no triangle meets: its winding number
+        off = np.flatnonzero(single == OFF)
+        wind[off] = above[off]
+        sub[off] = np.where(above[off] != 0, FULL, EMPTY)
         # boxes in a parent met by one triangle: its plane decides
         one = np.flatnonzero(single >= 0)
         if len(one):
             t = single[one]
             side = self.tris.plane_sides(t, blo[one], bhi[one])
             w = np.where(side > 0, above[one], below[one])
+            wind[one] = w
             sub[one] = np.where(side == 0, AMBIGUOUS, np.where(w != 0, FULL, EMPTY))
         # the others: against their parents' triangles, or cold against the grid's
         cold = np.flatnonzero(~found)
@@ -199,27 +241,30 @@ class MeshClassifier:
         pb, pt = np.concatenate([mb, fb]), np.concatenate([mt, ft])
         ok = self.tris.meet_boxes(pt, blo[pb], bhi[pb]) if len(pb) else np.zeros(0, dtype=bool)
         met_by = np.bincount(pb[ok], minlength=n)
-        tested = single < 0
+        tested = single == LISTED
         sub[tested & (met_by > 0)] = AMBIGUOUS
         off = np.flatnonzero(tested & (met_by == 0))
         if len(off):
             # off the surface: the whole box is on the side of its corner (exact, in the box)
-            w = self.winding.of_boxes(blo[off], bhi[off])
-            sub[off] = np.where(w != 0, FULL, EMPTY)
+            wind[off] = self.winding.of_boxes(blo[off], bhi[off])
+            sub[off] = np.where(wind[off] != 0, FULL, EMPTY)
         state[near] = sub
         if memory is not None and remember:
-            self._remember(memory, octants.level, codes, sub, single, above, below,
+            self._remember(memory, octants.level, codes, sub, single, above, below, wind,
                            blo, bhi, pb[ok], pt[ok], met_by)
         return state
 
     def _remember(self, memory: BoxMemory, level: int, codes: np.ndarray, sub: np.ndarray,
-                  single: np.ndarray, above: np.ndarray, below: np.ndarray, blo: np.ndarray,
-                  bhi: np.ndarray, pb: np.ndarray, pt: np.ndarray, met_by: np.ndarray) -> None:
-        """Keep the AMBIGUOUS boxes' triangles for their children: a box in a
-        one-triangle parent inherits its entry; a box now met by one triangle of a
-        closed mesh gets the winding numbers of its plane's two sides."""
+                  single: np.ndarray, above: np.ndarray, below: np.ndarray, wind: np.ndarray,
+                  blo: np.ndarray, bhi: np.ndarray, pb: np.ndarray, pt: np.ndarray,
+                  met_by: np.ndarray) -> None:
+        """Keep what the boxes hold for their children: an AMBIGUOUS box in a
+        one-triangle parent inherits its entry, one now met by one triangle of a
+        closed mesh gets the winding numbers of its plane's two sides, the others
+        their triangles; a box no triangle meets, its winding number ``wind``."""
         amb = sub == AMBIGUOUS
         single, above, below = single.copy(), above.copy(), below.copy()
+        single[~amb], above[~amb], below[~amb] = OFF, wind[~amb], 0
         fresh = amb & (single < 0) & (met_by == 1) & self.closed
         if fresh.any():
             which = np.flatnonzero(fresh)
@@ -230,13 +275,9 @@ class MeshClassifier:
             which, t = which[t_ok], t[t_ok]
             above[which], below[which] = self._sides(t, blo[which], bhi[which])
             single[which] = t
-        listed = amb & (single < 0)
+        listed = single == LISTED
         keep_pair = listed[pb]
-        rows = np.flatnonzero(amb)
-        index = np.full(len(sub), -1, dtype=np.int64)
-        index[rows] = np.arange(len(rows))
-        memory.put(level, codes[rows], single[rows], above[rows], below[rows],
-                   index[pb[keep_pair]], pt[keep_pair])
+        memory.put(level, codes, single, above, below, pb[keep_pair], pt[keep_pair])
 
     def _sides(self, t: np.ndarray, lo: np.ndarray, hi: np.ndarray):
         """Winding numbers of the parts of boxes ``[lo, hi]`` strictly above and below

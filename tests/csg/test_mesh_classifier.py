@@ -15,8 +15,8 @@ import pyvista as pv
 
 import implicitvox as ivx
 from csg import Box, Polyhedron, Sphere
-from csg.mesh_classifier import BoxMemory, MeshClassifier, edges_shared
-from implicitvox.expr.shape import takes_octants
+from csg.mesh_classifier import OFF, BoxMemory, MeshClassifier, edges_shared, forget_decided
+from implicitvox.expr.shape import Octants, takes_octants
 from implicitvox.octree.grid import grid_of
 from implicitvox.octree.subdivide import subdivide
 from implicitvox.triangles.inputs import as_triangles
@@ -122,3 +122,15 @@ def test_box_memory_gives_each_entry_once():
     assert again[0].tolist() == [False, True] and again[1].tolist() == [-1, 5]
     assert again[2].tolist() == [0, 1]
     assert len(memory) == 0
+
+
+def test_boxes_the_tree_decided_are_forgotten():
+    memory, run = BoxMemory(), {}
+    run["mesh"] = memory
+    codes = np.array([3, 9, 12], dtype=np.uint64)
+    memory.put(2, codes, np.array([OFF, 4, OFF]), np.array([1, 0, 0]), np.zeros(3, int),
+               np.zeros(0, int), np.zeros(0, int))
+    forget_decided(run, Octants(2, codes, run), np.array([0, 2]))
+    assert len(memory) == 1
+    found, single, above, *_ = memory.take(2, codes)
+    assert found.tolist() == [False, True, False] and single[1] == 4
