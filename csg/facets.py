@@ -296,15 +296,22 @@ def extrusion_mesh_outlines(pieces: list, height: float, twist: float, scale: np
             verts.append(layer)
             starts.append(base)
             base += len(layer)
-        tri = cap_triangles(rings)
-        # earcut's indices into the rings' points -> the mesh's bottom and top layers
-        owner = np.repeat(np.arange(len(rings)), [len(r) for r in rings])
-        local = np.concatenate([np.arange(len(r)) for r in rings])
-        bottom = np.asarray(starts)[owner] + local
-        upper = bottom + slices * np.array([len(r) for r in rings])[owner]
-        faces.append(bottom[tri[:, ::-1]])                         # bottom, facing down
-        faces.append(upper[tri])                                   # top, facing up
+        bottom, upper = _end_caps(rings, starts, slices)
+        faces.append(bottom[:, ::-1])                              # bottom, facing down
+        faces.append(upper)                                        # top, facing up
     return np.concatenate(verts), np.concatenate(faces).astype(np.int64)
+
+
+def _end_caps(rings: list, starts: list, steps: int) -> tuple[np.ndarray, np.ndarray]:
+    """The region's triangles (:func:`cap_triangles`, counter-clockwise) as vertex
+    indices of the first and the last layer of a mesh whose ring ``r`` has its
+    ``steps + 1`` layers of ``len(rings[r])`` points from ``starts[r]`` on."""
+    tri = cap_triangles(rings)
+    owner = np.repeat(np.arange(len(rings)), [len(r) for r in rings])
+    local = np.concatenate([np.arange(len(r)) for r in rings])
+    first = np.asarray(starts)[owner] + local
+    last = first + steps * np.array([len(r) for r in rings])[owner]
+    return first[tri], last[tri]
 
 
 def cap_triangles(rings: list) -> np.ndarray:
@@ -366,13 +373,9 @@ def rotation_mesh_outlines(pieces: list, angle: float, sectors: int
             starts.append(base)
             base += len(layer)
         if not full:
-            tri = cap_triangles(rings)
-            owner = np.repeat(np.arange(len(rings)), [len(r) for r in rings])
-            local = np.concatenate([np.arange(len(r)) for r in rings])
-            first = np.asarray(starts)[owner] + local
-            last = first + sectors * np.array([len(r) for r in rings])[owner]
-            faces.append(first[tri])                                   # at a_0
-            faces.append(last[tri[:, ::-1]])                           # at a_sectors
+            first, last = _end_caps(rings, starts, sectors)
+            faces.append(first)                                        # at a_0
+            faces.append(last[:, ::-1])                                # at a_sectors
     v, f = np.concatenate(verts), np.concatenate(faces).astype(np.int64)
     tv = v[f]
     collapsed = (np.all(tv[:, 0] == tv[:, 1], axis=1) | np.all(tv[:, 1] == tv[:, 2], axis=1)
