@@ -82,10 +82,10 @@ class BoxMemory:
 
     def put(self, level: int, codes: np.ndarray, single: np.ndarray, above: np.ndarray,
             below: np.ndarray, owner: np.ndarray, tris: np.ndarray) -> None:
-        """Remember boxes ``codes`` at ``level``: ``single`` their one triangle (or -1),
-        ``above``/``below`` the winding numbers of its plane's sides (an OFF box's
-        own in ``above``), and the pairs ``(owner, tris)`` (box index, triangle) of
-        the boxes with ``single`` :data:`LISTED`."""
+        """Remember boxes ``codes`` at ``level``: ``single`` their one triangle (or
+        :data:`LISTED`, :data:`OFF`), ``above``/``below`` the winding numbers of its
+        plane's sides (an OFF box's own in ``above``), and the pairs ``(owner,
+        tris)`` (box index, triangle) of the boxes with ``single`` :data:`LISTED`."""
         if not len(codes):
             return
         order = np.argsort(codes, kind="stable")
@@ -107,7 +107,7 @@ class BoxMemory:
         ``(owner, tris)`` of the listed triangles (owner: index into ``codes``)."""
         n = len(codes)
         found = np.zeros(n, dtype=bool)
-        single = np.full(n, -1, dtype=np.int64)
+        single = np.full(n, LISTED, dtype=np.int64)
         above = np.zeros(n, dtype=np.int64)
         below = np.zeros(n, dtype=np.int64)
         owners, tris = [], []
@@ -211,16 +211,13 @@ class MeshClassifier:
             return state
         blo, bhi = lo[near], hi[near]
         n = len(near)
-        memory = None
         if octants is not None:
             memory = octants.run.setdefault(("mesh", id(self)), BoxMemory())
             codes = octants.codes[near]
-            found, single, above, below, mb, mt = memory.take(octants.level - 1, codes >> 3)
-        else:
-            found = np.zeros(n, dtype=bool)
-            single = np.full(n, -1, dtype=np.int64)
-            above = below = np.zeros(n, dtype=np.int64)
-            mb = mt = np.zeros(0, dtype=np.int64)
+            level = octants.level - 1
+        else:                            # asked cold: an empty memory remembers nothing
+            memory, codes, level = BoxMemory(), np.zeros(n, dtype=np.uint64), 0
+        found, single, above, below, mb, mt = memory.take(level, codes >> 3)
         sub = np.zeros(n, dtype=np.int8)
         wind = np.zeros(n, dtype=np.int64)           # the winding number off the surface
         # boxes in a parent no triangle meets: its winding number
@@ -249,7 +246,7 @@ class MeshClassifier:
             wind[off] = self.winding.of_boxes(blo[off], bhi[off])
             sub[off] = np.where(wind[off] != 0, FULL, EMPTY)
         state[near] = sub
-        if memory is not None and remember:
+        if octants is not None and remember:
             self._remember(memory, octants.level, codes, sub, single, above, below, wind,
                            blo, bhi, pb[ok], pt[ok], met_by)
         return state
@@ -265,7 +262,7 @@ class MeshClassifier:
         amb = sub == AMBIGUOUS
         single, above, below = single.copy(), above.copy(), below.copy()
         single[~amb], above[~amb], below[~amb] = OFF, wind[~amb], 0
-        fresh = amb & (single < 0) & (met_by == 1) & self.closed
+        fresh = amb & (single == LISTED) & (met_by == 1) & self.closed
         if fresh.any():
             which = np.flatnonzero(fresh)
             first = np.full(len(sub), -1, dtype=np.int64)
@@ -289,9 +286,7 @@ class MeshClassifier:
         below = np.zeros(len(t), dtype=np.int64)
         for corner, want, out in ((np.where(positive, hi, lo), 1, above),
                                   (np.where(positive, lo, hi), -1, below)):
-            # a corner is a box of no extent: its side of the plane
-            side = self.tris.plane_sides(t, corner, corner)
-            strict = np.flatnonzero(side == want)
+            strict = np.flatnonzero(self.tris.planes.sign(t, corner) == want)
             if len(strict):
                 out[strict] = self.winding(corner[strict])
         return above, below
