@@ -21,8 +21,8 @@ For every ``/usr/share/openscad/examples/**/*.scad``:
    for ``cube(1)``). The two are timed in the same run, alternating (ours,
    OpenSCAD's, ours, ...), the best of :data:`ROUNDS` each where one round of
    both takes under :data:`CHEAP` seconds, one each otherwise (the machine is
-   shared: the best of several is the least disturbed). With OpenSCAD's facets every STL voxel must be
-   in the output (``missed``); the STL's vertices are rounded to 6 digits, so a
+   shared: the best of several is the least disturbed). With OpenSCAD's facets
+   every STL voxel must be in the output (``missed``); the STL's vertices are rounded to 6 digits, so a
    missed voxel that the STL enters by no more than that rounding (the largest
    inset of the voxel a triangle still meets, against 5e-6 of the triangle's
    largest coordinate: :func:`stl_depths`) is counted apart; an independent
@@ -126,6 +126,12 @@ def _write_constructs() -> Path:
     return root
 
 
+def _children_cpu() -> float:
+    """CPU seconds (user and system) of this process's finished children."""
+    use = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return use.ru_utime + use.ru_stime
+
+
 def _export(scad: Path, timeout: float, root: Path = EXAMPLES, cache: Path = CACHE) -> dict:
     """The model's .csg and .stl from the real OpenSCAD (cached), with the STL's CPU time."""
     rel = scad.relative_to(root).with_suffix("")
@@ -136,7 +142,7 @@ def _export(scad: Path, timeout: float, root: Path = EXAMPLES, cache: Path = CAC
         return json.loads(info_path.read_text())
     info = {"csg": str(out / "model.csg"), "stl": str(out / "model.stl")}
     for kind in ("csg", "stl"):
-        before = resource.getrusage(resource.RUSAGE_CHILDREN)
+        before = _children_cpu()
         t = time.perf_counter()
         try:
             done = subprocess.run(["openscad", "-o", info[kind], scad.name], cwd=scad.parent,
@@ -144,10 +150,8 @@ def _export(scad: Path, timeout: float, root: Path = EXAMPLES, cache: Path = CAC
             code, err = done.returncode, done.stderr
         except subprocess.TimeoutExpired:
             code, err = -1, f"timed out after {timeout:.0f} s"
-        after = resource.getrusage(resource.RUSAGE_CHILDREN)
         info[f"{kind}_seconds"] = time.perf_counter() - t
-        info[f"{kind}_cpu"] = (after.ru_utime - before.ru_utime) + \
-            (after.ru_stime - before.ru_stime)
+        info[f"{kind}_cpu"] = _children_cpu() - before
         info[f"{kind}_ok"] = code == 0 and os.path.exists(info[kind]) and \
             os.path.getsize(info[kind]) > 0
         if not info[f"{kind}_ok"]:
@@ -165,24 +169,26 @@ STL_ROUNDING = 5e-6
 EXAMINED = 200
 
 
-def _children_cpu() -> float:
-    """CPU seconds (user and system) of this process's finished children."""
-    use = resource.getrusage(resource.RUSAGE_CHILDREN)
-    return use.ru_utime + use.ru_stime
-
-
 def openscad_stl_cpu(scad: Path, timeout: float) -> float:
     """CPU seconds of one fresh STL export of ``scad`` by the real OpenSCAD, run from
-    the model's folder into a temporary file (``inf`` if it fails or times out)."""
+    the model's folder into a temporary file.
+
+    Raises
+    ------
+    RuntimeError
+        The export failed or took over ``timeout`` seconds (the model's row says so).
+    """
     with tempfile.TemporaryDirectory() as tmp:
         before = _children_cpu()
         try:
             done = subprocess.run(["openscad", "-o", str(Path(tmp) / "model.stl"), scad.name],
                                   cwd=scad.parent, capture_output=True, timeout=timeout)
         except subprocess.TimeoutExpired:
-            return float("inf")
+            raise RuntimeError(f"OpenSCAD's timed export took over {timeout:.0f} s") from None
         cpu = _children_cpu() - before
-    return cpu if done.returncode == 0 else float("inf")
+    if done.returncode != 0:
+        raise RuntimeError(f"OpenSCAD's timed export failed (exit code {done.returncode})")
+    return cpu
 
 
 def stl_depths(stl, triangles, missed: np.ndarray) -> np.ndarray:
