@@ -23,9 +23,9 @@ For every ``/usr/share/openscad/examples/**/*.scad``:
    both takes under :data:`CHEAP` seconds, one each otherwise (the machine is
    shared: the best of several is the least disturbed). With OpenSCAD's facets
    every STL voxel must be in the output (``missed``); the STL's vertices are
-   rounded to 6 digits, so a missed voxel that the STL enters by no more than that rounding (the largest
-   inset of the voxel a triangle still meets, against 5e-6 of the triangle's
-   largest coordinate: :func:`stl_depths`) is counted apart; an independent
+   rounded to 6 digits, so a missed voxel that the STL enters by no more than
+   that rounding (the largest inset of the voxel a triangle still meets, against
+   5e-6 of the triangle's largest coordinate: :func:`stl_depths`) is counted apart; an independent
    check samples 20,000 points on the STL's triangles and counts those no output
    voxel holds. With true curves, ``far`` counts STL voxels with no output voxel
    within one voxel. ``ratio`` is output voxels over STL voxels.
