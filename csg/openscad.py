@@ -133,6 +133,7 @@ def read_openscad(path_or_text: Any, facets: str = "openscad", base: Any = None)
     if base is None:
         base = os.path.dirname(os.path.abspath(source)) if source != "<csg>" else os.getcwd()
     builder = _Builder(source, facets == "openscad", os.fspath(base))
+    builder.build_from_leaves(nodes)
     built = [(n, s) for n, s in ((n, builder.build(n)) for n in nodes) if s is not None]
     if not built:
         raise OpenSCADError("the file holds no geometry", 1, 1, source)
@@ -172,6 +173,7 @@ def _root_node(nodes: list[Node]) -> Optional[Node]:
 class _Builder:
     def __init__(self, source: str, faceted: bool, base: str = "."):
         self.source, self.faceted, self.base = source, faceted, base
+        self._built: dict[int, tuple[Node, Optional[Solid]]] = {}
 
     def error(self, node: Node, message: str) -> OpenSCADError:
         return OpenSCADError(message, node.line, node.column, self.source)
@@ -227,7 +229,30 @@ class _Builder:
         return fn, fs, fa
 
     # -- nodes -----------------------------------------------------------------------------
+    def build_from_leaves(self, nodes: list[Node]) -> None:
+        """Build every node below ``nodes``, children before parents, without
+        recursion: a parent's :meth:`build` then finds its children built, so a
+        file nested :data:`~csg.openscad_parser.MAX_DEPTH` deep costs no deeper a
+        Python stack than a flat one. Background and disabled subtrees are not
+        entered (they are no geometry, and are not read further)."""
+        stack = [(n, False) for n in reversed(nodes)]
+        while stack:
+            node, expanded = stack.pop()
+            if id(node) in self._built or "%" in node.modifiers or "*" in node.modifiers:
+                continue
+            if expanded:
+                self.build(node)
+            else:
+                stack.append((node, True))
+                stack.extend((c, False) for c in reversed(node.children))
+
     def build(self, node: Node) -> Optional[Solid]:
+        """The solid of ``node`` (None: no geometry), built once."""
+        if id(node) not in self._built:
+            self._built[id(node)] = (node, self._build(node))   # (the node kept: ids stay unique)
+        return self._built[id(node)][1]
+
+    def _build(self, node: Node) -> Optional[Solid]:
         if "%" in node.modifiers or "*" in node.modifiers:
             return None                  # background and disabled subtrees are no geometry
         handler = getattr(self, "_" + node.name, None)

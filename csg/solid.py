@@ -85,14 +85,21 @@ class Solid:
         return ()
 
     # -- booleans ------------------------------------------------------------------
+    # A chain of operators (``a | b | c``, a loop ``u = u | part``) makes one n-ary
+    # boolean, as OpenSCAD's union() of many children: the same function (min and max
+    # chain left to right either way), and a tree as shallow as the model, not as deep
+    # as its parts are many (the tree's walks are recursive).
     def __or__(self, other: "Solid") -> "Solid":
-        return Union(self, _check_solid(other, "|"))
+        other = _check_solid(other, "|")
+        return Union(*_operands(self, Union), *_operands(other, Union))
 
     def __and__(self, other: "Solid") -> "Solid":
-        return Intersection(self, _check_solid(other, "&"))
+        other = _check_solid(other, "&")
+        return Intersection(*_operands(self, Intersection), *_operands(other, Intersection))
 
     def __sub__(self, other: "Solid") -> "Solid":
-        return Difference(self, _check_solid(other, "-"))
+        other = _check_solid(other, "-")
+        return Difference(*_operands(self, Difference), other)
 
     def __invert__(self) -> "Solid":
         return Complement(self)
@@ -239,6 +246,12 @@ class Solid:
     def __repr__(self) -> str:
         args = ", ".join(repr(c) for c in self.children)
         return f"{type(self).__name__}({args})"
+
+
+def _operands(solid: "Solid", kind: type) -> tuple:
+    """The operands ``solid`` brings to a boolean of ``kind``: its children if it is
+    one (exactly that class), else itself."""
+    return solid.children if type(solid) is kind else (solid,)
 
 
 def _check_solid(other: Any, op: str) -> "Solid":

@@ -225,7 +225,23 @@ class Expr:
         return _to_source(self)
 
     def __reduce__(self) -> tuple:
-        return (Expr, (self.op, self.args, self.param))
+        # flat, children first (:meth:`walk`): pickle's own recursion would overflow on a
+        # chain thousands deep (the union of thousands of parts); shared nodes stay shared
+        nodes: list[tuple] = []
+        index: dict[int, int] = {}
+        for node in self.walk():
+            index[id(node)] = len(nodes)
+            nodes.append((node.op, tuple(index[id(a)] for a in node.args), node.param))
+        return (_from_nodes, (tuple(nodes),))
+
+
+def _from_nodes(nodes: tuple) -> Expr:
+    """The expression :meth:`Expr.__reduce__` flattened: ``(op, argument indices,
+    param)`` per node, children first, the root last."""
+    built: list[Expr] = []
+    for op, args, param in nodes:
+        built.append(Expr(op, tuple(built[i] for i in args), param))
+    return built[-1]
 
 
 def substitute(expr: Expr, mapping: Mapping[str, Expr]) -> Expr:

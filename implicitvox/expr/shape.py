@@ -32,6 +32,7 @@ A bare expression is a shape without bounds or exact test.
 """
 from __future__ import annotations
 
+import sys
 from dataclasses import dataclass
 from typing import Any, Callable, Optional, Protocol, runtime_checkable
 
@@ -98,7 +99,14 @@ def as_shape(obj: Any) -> Any:
     """Return ``obj`` as a shape: expressions are wrapped, shapes pass through."""
     if isinstance(obj, Expr):
         return ExprShape(obj)
-    if isinstance(getattr(obj, "expr", None), Expr):
+    try:
+        expr = getattr(obj, "expr", None)
+    except RecursionError:       # a tree that builds its expression recursively, too deep
+        raise ValueError(f"the {type(obj).__name__} is nested too deeply to compile (its tree "
+                         f"is deeper than Python's recursion limit, {sys.getrecursionlimit()}): "
+                         "nest it less deeply (one n-ary union of many parts, one transform "
+                         "for a chain of them)") from None
+    if isinstance(expr, Expr):
         return obj
     raise TypeError(f"expected an implicitvox expression or a shape with .expr, got "
                     f"{type(obj).__name__} {obj!r:.60}")

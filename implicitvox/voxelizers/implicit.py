@@ -272,7 +272,7 @@ def _run(source: ImplicitSource, grid: Grid, progress, start, interior_before,
     for level, coords in result.interior.items():
         interior[level] = np.concatenate([interior[level], coords]) if level in interior else coords
     metadata = {
-        "model": repr(shape.expr)[:2000],
+        "model": repr(func.expr)[:2000],
         "seconds_subdivide": t1 - t0,
         "seconds_total": time.perf_counter() - t0,
         "boxes_evaluated": result.evaluated,

@@ -463,3 +463,32 @@ def test_faces_shared_inside_a_union_are_no_surface(turn):
         assert vox.count == expected.count
         assert np.array_equal(vox.coords(), expected.coords())
     assert halves.regularized_boundary is not None
+
+
+def test_chained_operators_make_one_boolean_and_run_in_parallel():
+    """``a | b | c ...`` (a loop ``u = u | part``) is one n-ary union, as OpenSCAD's
+    union() of many children: the same function, a shallow tree, so a model of
+    thousands of parts compiles and pickles for the workers."""
+    parts = [Sphere(0.02).translate((0.01 * i, 0.0, 0.0)) for i in range(600)]
+    chain = parts[0]
+    for part in parts[1:]:
+        chain = chain | part
+    assert type(chain) is csg.Union and len(chain.children) == 600
+    assert chain.expr == ivx.min(*[p.expr for p in parts])
+    assert len((parts[0] & parts[1] & parts[2]).children) == 3
+    cut = Box(2) - parts[0] - parts[1] - parts[2]
+    assert type(cut) is csg.Difference and cut.children[1:] == tuple(parts[:3])
+    inner = parts[1] - parts[2]                      # a - (b - c) stays nested
+    assert (parts[0] - inner).children == (parts[0], inner)
+    serial = ivx.voxelize(chain, 24, workers=1)
+    parallel = ivx.voxelize(chain, 24, workers=2)
+    assert parallel.metadata["workers"] == 2
+    assert np.array_equal(np.unique(parallel.coords(), axis=0), np.unique(serial.coords(), axis=0))
+
+
+def test_a_tree_too_deep_to_compile_is_refused_by_name():
+    solid = Sphere(1.0)
+    for _ in range(3000):
+        solid = solid.translate((0.001, 0.0, 0.0))
+    with pytest.raises(ValueError, match="Transformed is nested too deeply to compile"):
+        ivx.voxelize(solid, 16)

@@ -205,6 +205,26 @@ def test_hostile_nesting_and_size_fail_fast():
         read_openscad("group();", facets="true")
 
 
+def test_a_file_nested_as_deep_as_allowed_reads_and_runs_in_parallel():
+    """Every level keeps a cube and a transform, so the solid is as deep as the file; the
+    builder, the compiler and the parallel run's pickling must all take it."""
+    from csg.openscad_parser import MAX_DEPTH
+    level = ("multmatrix([[1, 0, 0, 0.05], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]]) "
+             "{ union() { cube(0.02); ")
+    text = level * (MAX_DEPTH // 2) + "sphere(1);" + "} }" * (MAX_DEPTH // 2)
+    solid = read_openscad(text, facets="true")
+    depth, node = 0, solid
+    while node.children:
+        depth, node = depth + 1, node.children[-1]
+    assert depth == MAX_DEPTH
+    serial = ivx.voxelize(solid, 16, workers=1)
+    parallel = ivx.voxelize(solid, 16, workers=2)
+    assert parallel.metadata["workers"] == 2
+    assert np.array_equal(np.unique(parallel.coords(), axis=0), np.unique(serial.coords(), axis=0))
+    with pytest.raises(OpenSCADError, match="nesting deeper"):
+        read_openscad(level + text + "} }", facets="true")
+
+
 def test_truncated_file(tmp_path):
     text = (FIXTURES / "knob.csg").read_text()
     path = tmp_path / "cut.csg"

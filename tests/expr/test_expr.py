@@ -100,3 +100,16 @@ def test_repr_reads_back_as_python(expr):
 def test_repr_of_tricky_forms_reads_back(text):
     expr = eval(text, dict(NAMESPACE))
     assert eval(repr(expr), dict(NAMESPACE)).equals(expr)
+
+
+def test_a_deep_expression_pickles_flat_and_shared():
+    """A union of thousands of parts is a chain thousands deep; pickling it must not
+    recurse (the parallel runs pickle the shape), and shared nodes stay shared."""
+    import pickle
+    parts = [ivx.sqrt((x - 0.001 * i) ** 2 + y * y + z * z) - 0.5 for i in range(2000)]
+    deep = ivx.min(*parts)
+    back = pickle.loads(pickle.dumps(deep, protocol=pickle.HIGHEST_PROTOCOL))
+    assert back == deep and hash(back) == hash(deep)
+    square = x * x
+    shared = pickle.loads(pickle.dumps(square + square))
+    assert shared.args[0] is shared.args[1]
