@@ -10,7 +10,7 @@ import numpy as np
 
 from ..interval import kernels as I
 from ..interval.float32 import exact_in_float32, float32_bounds, outward_float32
-from .pruning import settle
+from .pruning import settle, settle_in_tree
 from .tape import Tape
 from .. import batches
 
@@ -100,13 +100,32 @@ def apply_op(op, param, lo: tuple, hi: tuple, single: bool = False):
 def _evaluate(tape, lo, hi, single: bool, flo: np.ndarray, fhi: np.ndarray,
               choices: np.ndarray | None = None) -> None:
     """The enclosures over one pass of boxes, written into ``flo, fhi`` (and the
-    branch choices into ``choices``)."""
-    shape = flo.shape
+    branch choices into ``choices``). A branch of a min tree (max tree) is
+    settled against the tree's whole minimum (:func:`settle_in_tree`), which the
+    tree's root computes after its branches: so such a tape runs twice, once for
+    the roots' bounds and once for the choices."""
     if choices is not None:
         choices[...] = 0
     if tape.undefined:
         flo[...], fhi[...] = np.inf, -np.inf
         return
+    trees = tape.choice_trees if choices is not None else ()
+    totals = None
+    if any(t >= 0 for t in trees):
+        roots = {t for t in trees if t >= 0}
+        totals = {}
+        _run(tape, lo, hi, single, flo, fhi, None, None, roots, totals)
+    _run(tape, lo, hi, single, flo, fhi, choices, totals)
+
+
+def _run(tape, lo, hi, single: bool, flo: np.ndarray, fhi: np.ndarray,
+         choices: np.ndarray | None, totals: dict | None = None, roots: set | None = None,
+         kept: dict | None = None) -> None:
+    """One run of the tape (see :func:`_evaluate`): with ``roots``, the bound of
+    each root instruction its tree is settled against goes into ``kept``; with
+    ``totals`` (those bounds), the branches of trees are settled against them."""
+    trees = tape.choice_trees if totals is not None else ()
+    shape = flo.shape
     branch = 0
     dtype = np.float32 if single else np.float64
     rlo: list = [None] * tape.n_registers
@@ -122,12 +141,19 @@ def _evaluate(tape, lo, hi, single: bool, flo: np.ndarray, fhi: np.ndarray,
             rlo[c.register], rhi[c.register] = np.float64(c.lo), np.float64(c.hi)
     empty = None
     with np.errstate(all="ignore"):
-        for ins in tape.instructions:
+        for i, ins in enumerate(tape.instructions):
             args_lo, args_hi = tuple(rlo[a] for a in ins.args), tuple(rhi[a] for a in ins.args)
             if ins.op.choice and choices is not None:
-                np.copyto(choices[branch], settle(ins.op.name, args_lo, args_hi, dtype))
+                root = trees[branch] if totals is not None else -1
+                if root >= 0:
+                    np.copyto(choices[branch], settle_in_tree(ins.op.name, args_lo, args_hi,
+                                                              totals[root], dtype))
+                else:
+                    np.copyto(choices[branch], settle(ins.op.name, args_lo, args_hi, dtype))
                 branch += 1
             result = apply_op(ins.op, ins.param, args_lo, args_hi, single)
+            if roots is not None and i in roots:      # a min tree's minimum is its upper bound
+                kept[i] = result[1] if ins.op.name == "min" else result[0]
             if ins.op.domain:
                 result, lane_empty = result[:2], result[2]
                 empty = lane_empty if empty is None else (empty | lane_empty)

@@ -59,7 +59,7 @@ import numpy as np
 from .opcodes import OPCODES
 from .tape import Tape, Value, allocate
 
-__all__ = ["settle", "simplify", "Pruner", "UNDECIDED", "FIRST", "SECOND", "RELATIVE_GAP",
+__all__ = ["settle", "settle_in_tree", "simplify", "Pruner", "UNDECIDED", "FIRST", "SECOND", "RELATIVE_GAP",
            "CALL_COST", "MAX_SIGNATURES", "RUN"]
 
 #: choices: both operands may still win; the first wins (``abs``: the argument
@@ -111,6 +111,43 @@ def settle(name: str, lo: tuple, hi: tuple, dtype) -> np.ndarray:
     if name == "max":
         a_below, b_below = b_below, a_below
     return a_below + b_below + b_below
+
+
+def settle_in_tree(name: str, lo: tuple, hi: tuple, total: np.ndarray, dtype) -> np.ndarray:
+    """The choice of a ``min`` (``max``) instruction of a min tree (max tree,
+    :attr:`implicitvox.eval.tape.Tape.choice_trees`) over boxes, against the
+    whole tree: ``total`` is the upper (lower) bound of the tree's root, the
+    n-ary ``min`` of all its leaves.
+
+    An operand whose lower bound lies above ``total`` is above the minimum at
+    every point of the box, and over every sub-box (the operand's bound only
+    rises there, the total only falls): it is dropped, whichever operands it
+    was bracketed with (:func:`settle` compares the two operands alone, so in a
+    chain ``min(min(min(a, b), c), d)`` a part could only lose to the parts
+    before it). The kept operands' minimum is the same, bit for bit (``min`` is
+    exact). When both operands are dropped (the instruction's whole subtree is
+    above the total, so its parent drops it too), the first is kept.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> lo, hi = (np.array([5.0]), np.array([0.0])), (np.array([6.0]), np.array([1.0]))
+    >>> settle_in_tree("min", lo, hi, np.array([0.5]), np.float64)   # the first is dropped
+    array([2], dtype=int8)
+    """
+    gap = RELATIVE_GAP[np.dtype(dtype)]
+    with np.errstate(all="ignore"):   # empty and unbounded operands: NaN comparisons
+        if name == "min":
+            a, b = lo
+            total_up = total + gap * (np.abs(a) + np.abs(b) + 2 * np.abs(total))
+            b_out = np.asarray(b > total_up)
+            a_out = np.asarray(a > total_up) & ~b_out
+        else:
+            a, b = hi
+            total_down = total - gap * (np.abs(a) + np.abs(b) + 2 * np.abs(total))
+            b_out = np.asarray(b < total_down)
+            a_out = np.asarray(a < total_down) & ~b_out
+    return b_out.view(np.int8) + 2 * a_out.view(np.int8)
 
 
 def simplify(tape: Tape, choices: Sequence[int], max_length: Optional[int] = None

@@ -114,6 +114,33 @@ class Tape:
         the ones :mod:`implicitvox.eval.pruning` can settle over a box."""
         return tuple(i for i, ins in enumerate(self.instructions) if ins.op.choice)
 
+    @functools.cached_property
+    def choice_trees(self) -> tuple[int, ...]:
+        """Per branch (in :attr:`branches` order): the instruction at the root of its
+        *min tree* (``max`` tree), or -1. A min tree is a ``min`` whose arguments
+        are ``min`` instructions read by nothing else, and theirs, and so on: the
+        n-ary ``min`` of its leaves however it is bracketed (a chain ``min(min(a,
+        b), c)`` from a union of many parts). Only trees of two or more
+        instructions are named (:func:`implicitvox.eval.pruning.settle_in_tree`)."""
+        values, root, _ = self.graph
+        fixed = len(values) - len(self.instructions)
+        uses = [0] * len(values)
+        uses[root] += 1
+        for value in values[fixed:]:
+            for a in value.args:
+                uses[a] += 1
+        top = list(range(len(self.instructions)))        # instruction -> its tree's root
+        member = [False] * len(self.instructions)
+        for i in range(len(self.instructions) - 1, -1, -1):
+            op = self.instructions[i].op.name
+            if op not in ("min", "max"):
+                continue
+            for a in values[fixed + i].args:
+                j = a - fixed
+                if j >= 0 and uses[a] == 1 and self.instructions[j].op.name == op:
+                    top[j], member[j], member[i] = top[i], True, True
+        return tuple(top[i] if member[i] else -1 for i in self.branches)
+
 
 @dataclass
 class Value:

@@ -114,6 +114,26 @@ def test_settle(name, lo, hi, expected):
     assert settle(name, lo, hi, np.float64).tolist() == [expected]
 
 
+def test_a_part_of_a_union_is_dropped_against_the_whole_union():
+    """Over [0, 1]^3: 2x in [0, 2], x + 1.5 in [1.5, 2.5], x in [0, 1]. Against 2x alone
+    x + 1.5 may still win; against the whole union's upper bound 1 (from x, which
+    comes later in the chain) it never does."""
+    tape = build_tape(ivx.min(2.0 * x, x + 1.5, x))
+    assert tape.choice_trees == (len(tape) - 1,) * 2      # one min tree of two instructions
+    box = (0.0, 0.0, 0.0), (1.0, 1.0, 1.0)
+    assert settle("min", *[tuple(np.array([v]) for v in end) for end in ((0.0, 1.5), (2.0, 2.5))],
+                  np.float64).tolist() == [UNDECIDED]            # the pair alone: undecided
+    assert _choices(tape, *box, np.float64).tolist() == [FIRST, UNDECIDED]
+    kept = simplify(tape, _choices(tape, *box, np.float64))
+    assert [ins.op.name for ins in kept.instructions] == ["mulc", "min"]
+
+
+def test_a_min_read_twice_is_no_part_of_a_tree():
+    inner = ivx.min(x, y)
+    tape = build_tape(ivx.min(inner, z) + inner)
+    assert tape.choice_trees == (-1, -1)
+
+
 def test_a_branch_reading_a_domain_operation_is_kept():
     """Dropping sqrt(g) would lose the whole tape's verdict "undefined" where g < 0."""
     expr = ivx.min(x - 5.0, ivx.sqrt(y))
