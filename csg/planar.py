@@ -364,6 +364,19 @@ def _as_2d(shape: Solid) -> Solid:
     return shape
 
 
+def _radii(shape: Solid) -> tuple[float, float]:
+    """Bounds on the distances from the origin of a 2D shape's points: nearest and
+    farthest, from the boxes of a union's children (the corners, and the box's
+    distance, 0 where it holds the origin)."""
+    if isinstance(shape, Union):
+        parts = [_radii(c) for c in shape.children]
+        return min(p[0] for p in parts), max(p[1] for p in parts)
+    lo, hi = np.array(shape.bounds[0][:2]), np.array(shape.bounds[1][:2])
+    far = float(np.max(np.hypot(*np.meshgrid([lo[0], hi[0]], [lo[1], hi[1]]))))
+    gap = np.maximum(np.maximum(lo, -hi), 0.0)       # the origin's distance to the box
+    return float(np.hypot(*gap)), far
+
+
 class LinearExtrude(Solid):
     """See :func:`linear_extrude`."""
 
@@ -404,7 +417,30 @@ class LinearExtrude(Solid):
             a = -math.radians(self.twist) * t
             u, v = iv.cos(a) * u + iv.sin(a) * v, -iv.sin(a) * u + iv.cos(a) * v
         section = self._children[0].expr.remap(x=u, y=v)
-        return iv.max(section, z0 - z, z - (z0 + h))
+        if (self.twist == 0 and np.all(self.scale_top == 1)) or self._children[0].bounds is None:
+            return iv.max(section, z0 - z, z - (z0 + h))
+        # The solid lies within the cone (cylinder) of the section's reach: the sign is
+        # the same, but the intervals reject what the turned, rescaled section cannot
+        # (undoing a scale near 0 is unbounded: every box at a pointed top would be kept).
+        # The solid lies within the annulus (cone) of the section's radii: the sign is the
+        # same, but the intervals reject what the turned, rescaled section cannot (undoing
+        # a scale near 0 is unbounded: every box at a pointed top would be kept).
+        near, far = _radii(self._children[0])
+        # (widened by a relative 2**-20: a box in the solid whose corner touches the
+        # annulus, as a square's corners touch it along the edges they sweep, keeps its
+        # state whatever the rounding of the bound)
+        near, far = near * (1.0 - 2.0 ** -20), far * (1.0 + 2.0 ** -20)
+        grow, shrink = float(np.max(self.scale_top)) - 1.0, float(np.min(self.scale_top)) - 1.0
+        rho = iv.sqrt(x * x + y * y)
+        bounds = [rho - (far * (1.0 + grow * t) if grow else far)]
+        if near > 0:
+            bounds.append((near * (1.0 + shrink * t) if shrink else near) - rho)
+        return iv.max(section, *bounds, z0 - z, z - (z0 + h))
+
+    @property
+    def _reach(self) -> float:
+        """The section's farthest point from the axis (a bound)."""
+        return _radii(self._children[0])[1]
 
     @property
     def bounds(self) -> Bounds:
@@ -414,7 +450,7 @@ class LinearExtrude(Solid):
         lo, hi = np.array(b[0][:2]), np.array(b[1][:2])
         s = np.maximum(self.scale_top, 1.0)
         if self.twist != 0:                      # any rotation: the disc of the farthest corner
-            r = float(np.max(np.hypot(*np.meshgrid([lo[0], hi[0]], [lo[1], hi[1]]))))
+            r = self._reach
             lo, hi = np.array([-r, -r]), np.array([r, r])
         lo, hi = np.minimum(lo * s, lo), np.maximum(hi * s, hi)
         z0 = self._z0

@@ -492,3 +492,34 @@ def test_a_tree_too_deep_to_compile_is_refused_by_name():
         solid = solid.translate((0.001, 0.0, 0.0))
     with pytest.raises(ValueError, match="Transformed is nested too deeply to compile"):
         ivx.voxelize(solid, 16)
+
+
+def test_a_twisted_extrusion_to_a_point_keeps_no_voxel_off_its_cone():
+    """OpenSCAD's Basics/linear_extrude cone: a 20 x 10 rectangle turned -360 degrees and
+    scaled to 0 over 40. Undoing a scale near 0 is unbounded, so the turned section
+    alone keeps every box at the top; the solid lies in the cone of the section's
+    reach (rho <= R (1 - t)), and every voxel kept must meet that cone."""
+    solid = linear_extrude(Rectangle((20, 10), center=True), 40, twist=-360, scale=0,
+                           center=True)
+    vox = ivx.voxelize(solid, 64, bounds=((-12, -12, -21), (12, 12, 21)))
+    lo, h = np.asarray(vox.bounds[0]), np.asarray(vox.voxel_size)
+    box_lo = lo + vox.coords() * h
+    box_hi = box_lo + h
+    nearest = np.hypot(*np.maximum(np.maximum(box_lo[:, :2], -box_hi[:, :2]), 0.0).T)
+    widest = math.hypot(10, 5) * (1 - (box_lo[:, 2] + 20) / 40)   # the cone at the box's bottom
+    assert vox.count > 1000 and np.all(nearest <= widest + 1e-9)
+
+
+def test_a_twisted_extrusion_off_the_axis_keeps_no_voxel_inside_its_annulus():
+    """A section 5 to 7 from the axis, turned 720 degrees: its points stay 5 to 7 from
+    the axis, and so must the voxels kept (each meets the annulus)."""
+    section = Rectangle((2, 2), center=True).translate((6, 0))
+    solid = linear_extrude(section, 10, twist=720)
+    vox = ivx.voxelize(solid, 64, bounds=((-8, -8, -0.5), (8, 8, 10.5)))
+    lo, h = np.asarray(vox.bounds[0]), np.asarray(vox.voxel_size)
+    box_lo = lo + vox.coords() * h
+    box_hi = box_lo + h
+    corners = np.stack([np.where(np.abs(box_lo[:, :2]) > np.abs(box_hi[:, :2]), box_lo[:, :2],
+                                 box_hi[:, :2])], 0)[0]
+    farthest = np.hypot(*corners.T)
+    assert vox.count > 1000 and np.all(farthest >= 5.0 - 1e-9)
