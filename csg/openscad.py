@@ -62,7 +62,7 @@ import numpy as np
 from . import facets as fx
 from .clipper2d import NotFlat, offset as clipped_offset, region_pieces
 from .dxf import read_dxf
-from .prism import Prism
+from .prism import Prism, bound_functions
 from .projection import NotAMesh, projection as project
 from .text import text_polygon
 from .heightmap import heightmap_mesh
@@ -145,6 +145,7 @@ def read_openscad(path_or_text: Any, facets: str = "openscad", base: Any = None)
                             "solid): implicitvox voxelizes 3D solids; extrude it "
                             "(linear_extrude, rotate_extrude) first", first.line, first.column,
                             source)
+    bound_functions(solid)      # many prisms: their exact tests, not their functions
     return solid
 
 

@@ -125,3 +125,26 @@ def test_a_long_outline_has_a_bound_for_its_function_and_the_same_voxels(monkeyp
         assert not full.needs_exact_test
         exact = full.rotate("x", 90).voxelize(48, interior=True)
     assert bounded.count > 0 and voxel_digests(bounded) == voxel_digests(exact)
+
+
+def test_many_small_prisms_of_a_model_keep_only_their_bounds_and_the_same_voxels():
+    """A model of many short-outlined prisms (OpenSCAD's example023: 51 of 20 vertices)
+    pays for every prism's function on every box; past TREE_FUNCTION_VERTICES in all
+    they keep only their bounds, and the exact tests give the same voxels."""
+    from csg.prism import TREE_FUNCTION_VERTICES, bound_functions
+    from tests.golden.digests import voxel_digests
+    def letter(i: int) -> str:        # a 5-vertex outline, moved along x
+        return (f"multmatrix([[1, 0, 0, {3 * i}], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]]) "
+                "{ linear_extrude(height = 2) { polygon(points = [[0, 0], [2, 0], [2, 2], "
+                "[1, 1], [0, 2]], paths = [[0, 1, 2, 3, 4]]); } }")
+    letters = " ".join(letter(i) for i in range(TREE_FUNCTION_VERTICES // 5 + 1))
+    bounded = csg.read_openscad(f"union() {{ {letters} }}")
+    kept = csg.read_openscad(f"union() {{ {letters} }}")
+    prisms = [leaf for leaf in bounded.children if isinstance(leaf.children[0], Prism)]
+    assert prisms and all(p.children[0].needs_exact_test for p in prisms)
+    for leaf in kept.children:
+        leaf.children[0].needs_exact_test = False         # their functions, as before
+    assert voxel_digests(bounded.voxelize(64, interior=True)) == \
+        voxel_digests(kept.voxelize(64, interior=True))
+    few = csg.read_openscad(letter(0))                      # one prism: its function
+    assert not few.children[0].needs_exact_test and bound_functions(few) == 0
