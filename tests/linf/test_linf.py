@@ -767,3 +767,28 @@ def test_quadric_classification_on_a_million_boxes(name):
     bad = got != want
     assert np.all(np.minimum(np.abs(vmin), np.abs(vmax))[bad] < 1e-12)
     assert (want == AMBIGUOUS).sum() > 10**5
+
+
+def test_a_box_along_the_axes_takes_the_columns_and_the_same_bits():
+    """A box along the axes (OpenSCAD's cube) is measured by columns, not by (n, F)
+    products: the same operations on the same numbers, so bit for bit the general
+    polytope's distance, on points inside, outside, on faces and at corners, with
+    per-point and shared weights."""
+    import copy
+    from implicitvox.linf.polyhedron import ConvexPolyhedron
+    rng = np.random.default_rng(7)
+    corners = np.array([[x, y, z] for x in (-1.5, 2.0) for y in (0.0, 3.0) for z in (-0.25, 0.5)])
+    box = ConvexPolyhedron.from_points(corners)
+    general = copy.copy(box)
+    general._axis_aligned = None
+    assert box._axis_aligned is not None
+    p = rng.uniform(-3, 4, (4000, 3))
+    p[:500] = corners[rng.integers(0, 8, 500)]              # corners and faces: ties
+    p[500:1000, 0] = rng.choice([-1.5, 2.0], 500)
+    p[1000:1100] = 0.0
+    for w in (rng.uniform(0.5, 2.0, (len(p), 3)), np.tile([0.25, 0.5, 2.0], (len(p), 1))):
+        a, b = box.distance(p, w), general.distance(p, w)
+        assert np.array_equal(a.view(np.uint64), b.view(np.uint64))
+    tilted = ConvexPolyhedron.from_points(corners @ np.array([[0.8, 0.6, 0], [-0.6, 0.8, 0],
+                                                               [0, 0, 1.0]]))
+    assert tilted._axis_aligned is None
