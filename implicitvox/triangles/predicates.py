@@ -62,9 +62,32 @@ def exact_integers(*columns: np.ndarray) -> list[np.ndarray]:
     return list(out)
 
 
+def _lowest_exponent(*arrays: np.ndarray) -> int:
+    """The least power of two ``e`` such that every float of ``arrays`` is an
+    integer times ``2**e`` (0 when all are zero)."""
+    lows = []
+    for m in arrays:
+        mant, expo = np.frexp(m)
+        expo = expo[mant != 0]
+        if expo.size:
+            lows.append(int(expo.min()) - 53)
+    return min(lows, default=0)
+
+
+def _integers_at(values: np.ndarray, low: int) -> np.ndarray:
+    """Finite floats as an object array of Python ints, in units of ``2**low``
+    (``low`` at most :func:`_lowest_exponent` of ``values``)."""
+    mant, expo = np.frexp(values)
+    ints = (mant * 2.0 ** 53).astype(np.int64)            # exact: |mant| < 1
+    shift = np.where(mant == 0, 0, expo.astype(np.int64) - 53 - low)
+    return np.left_shift(ints.astype(object), shift.astype(object))
+
+
 def _sign_objects(values: np.ndarray) -> np.ndarray:
-    return np.array([(v > 0) - (v < 0) for v in values], dtype=np.int8) if len(values) \
-        else np.zeros(0, dtype=np.int8)
+    """Signs (-1, 0, 1) of an object array of Python ints, as int8."""
+    if not len(values):
+        return np.zeros(0, dtype=np.int8)
+    return (values > 0).astype(np.int8) - (values < 0).astype(np.int8)
 
 
 def det2_sign(a: np.ndarray, b: np.ndarray, p: np.ndarray, q: np.ndarray) -> np.ndarray:
@@ -183,9 +206,29 @@ class FixedPlanes:
             sign = np.sign(det).astype(np.int8)
         unsure = np.flatnonzero(~sure)
         if len(unsure):
-            rows = which[unsure]
-            sign[unsure] = orient3d_sign(self.a[rows], self.b[rows], self.c[rows], d[unsure])
+            sign[unsure] = self._exact_sign(which[unsure], d[unsure])
         return sign
+
+    def _exact_sign(self, which: np.ndarray, d: np.ndarray) -> np.ndarray:
+        """The exact sign of ``n . (d - a)`` for the rows the float filter left open.
+
+        All coordinates of the batch (the rows' points and their triangles'
+        vertices) become Python integers at one common power of two; each
+        distinct triangle's normal ``N`` and offset ``N . A`` are computed once,
+        so a row costs three products and a difference of integers.
+        """
+        tris, row_tri = np.unique(which, return_inverse=True)
+        a, b, c = self.a[tris], self.b[tris], self.c[tris]
+        low = _lowest_exponent(a, b, c, d)
+        A, B, C, D = (_integers_at(m, low) for m in (a, b, c, d))
+        U, V = B - A, C - A
+        N = np.stack([U[:, 1] * V[:, 2] - U[:, 2] * V[:, 1],
+                      U[:, 2] * V[:, 0] - U[:, 0] * V[:, 2],
+                      U[:, 0] * V[:, 1] - U[:, 1] * V[:, 0]], axis=1)
+        offset = (N * A).sum(axis=1)
+        N = N[row_tri]
+        det = N[:, 0] * D[:, 0] + N[:, 1] * D[:, 1] + N[:, 2] * D[:, 2] - offset[row_tri]
+        return _sign_objects(det)
 
 
 def _columns(v):
