@@ -230,7 +230,7 @@ def polygonal_radius(n_sectors: int, angle: float, start: float = 0.0) -> Expr:
     scale = 1.0 / math.cos(math.radians(w / 2))
     if abs(w) >= 180:
         raise ValueError(f"{n_sectors} sector(s) over {angle} degrees: each must be < 180")
-    terms = [(ci * scale) * x + (si * scale) * y for ci, si in zip(c, s)]
+    terms = [iv.affine((ci * scale, si * scale), (x, y)) for ci, si in zip(c, s)]
     return iv.max(*terms) if len(terms) > 1 else terms[0]
 
 

@@ -158,7 +158,7 @@ def _edge(p: np.ndarray, q: np.ndarray) -> Expr:
     """The distance outward of the line from ``p`` to ``q`` (the inside on its left)."""
     n = np.array([q[1] - p[1], p[0] - q[0]])
     n /= np.linalg.norm(n)
-    return n[0] * (x - p[0]) + n[1] * (y - p[1])
+    return iv.affine(n, (x - p[0], y - p[1]))
 
 
 def _area(poly: np.ndarray) -> float:

@@ -274,7 +274,7 @@ class HalfSpace(Solid):
     @property
     def expr(self) -> Expr:
         n = self.normal
-        return n[0] * x + n[1] * y + n[2] * z - self.offset
+        return iv.affine(n, (x, y, z), -self.offset)
 
     @property
     def bounds(self) -> Bounds:
@@ -327,7 +327,7 @@ class ConvexPolyhedron(Solid):
 
     @property
     def expr(self) -> Expr:
-        terms = [n[0] * x + n[1] * y + n[2] * z - d for n, d in zip(self.normals, self.offsets)]
+        terms = [iv.affine(n, (x, y, z), -d) for n, d in zip(self.normals, self.offsets)]
         return iv.max(*terms) if len(terms) > 1 else terms[0]
 
     @property

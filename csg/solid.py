@@ -468,7 +468,7 @@ class Transformed(Solid):
     @property
     def expr(self) -> Expr:
         inv = self.inverse
-        u = [inv[i, 0] * x + inv[i, 1] * y + inv[i, 2] * z + inv[i, 3] for i in range(3)]
+        u = [iv.affine(inv[i, :3], (x, y, z), inv[i, 3]) for i in range(3)]
         return self._children[0].expr.remap(x=u[0], y=u[1], z=u[2])
 
     @property

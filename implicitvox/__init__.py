@@ -16,8 +16,8 @@ from .version import __version__
 from .expr.nodes import Expr, constant, wrap, x, y, z
 from .expr.coords import (Cylindrical, Spherical, cylindrical, elevation, phi, r, radius, rho,
                           spherical, theta)
-from .expr.functions import (abs, acos, asin, atan, atan2, clip, cos, exp, floor, hypot, log,
-                             max, min, sin, sqrt, square, tan)
+from .expr.functions import (abs, acos, affine, asin, atan, atan2, clip, cos, exp, floor, hypot,
+                             log, max, min, sin, sqrt, square, tan)
 from .expr.shape import AMBIGUOUS, EMPTY, FULL, Shape
 from .expr.sweeps import repeat, repeat_polar
 from .eval.function import Function, compile
@@ -45,6 +45,6 @@ __all__ = [
     "utah_teapot", "linf", "linf_distance", "Voxels", "Grid", "Octree", "PointerOctree", "load",
     "Shape", "EMPTY", "FULL", "AMBIGUOUS", "distance_field", "DistanceField", "load_field",
     "suitability", "Suitability",
-    "abs", "acos", "asin", "atan", "atan2", "clip", "cos", "exp", "floor", "hypot", "log",
-    "max", "min", "sin", "sqrt", "square", "tan",
+    "abs", "acos", "affine", "asin", "atan", "atan2", "clip", "cos", "exp", "floor", "hypot",
+    "log", "max", "min", "sin", "sqrt", "square", "tan",
 ]

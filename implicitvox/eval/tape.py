@@ -12,6 +12,8 @@ it is read. Building it
 * **folds constants**: an operation on constants becomes a constant that
   keeps both its point value and an outward-rounded enclosure ``[lo, hi]``
   from the interval kernel, so ``sin(1.0)`` folded is still a sound interval;
+* **drops exact identities**: ``a * 1``, ``a / 1`` and ``a - 0`` (which is
+  ``a + (-0.0)``) are ``a`` bit for bit, so they take no instruction;
 * **rewrites** ``a * a`` and ``a ** 2`` into ``square(a)`` (tighter intervals),
   and ``sqrt((a - c0)**2 + (b - c1)**2 + (w - c2)**2)`` (two or three terms,
   summed left to right as Python writes them) into one ``distance`` node: the
@@ -36,6 +38,7 @@ from dataclasses import dataclass
 from typing import Any
 
 import functools
+import math
 
 import numpy as np
 
@@ -200,6 +203,9 @@ def build_tape(expr: Expr) -> Tape:
             if (op.name == "mul" and args[0] == args[1]) or (op.name == "powi" and param == 2):
                 op, args, param = OPCODES["square"], args[:1], None
             op, args, param = _with_constant_operand(op, args, param, values)
+            if _is_identity(op, param):
+                index_of_node[id(node)] = args[0]
+                continue
             op, args, param = _periodic_of_angle(op, args, param, values)
             op, args, param = _distance_of_squares(op, args, param, values, intern)
             if not op.oracle and all(values[a].kind == "const" for a in args):
@@ -239,6 +245,15 @@ def _with_constant_operand(op: Opcode, args: tuple[int, ...], param: Any,
     if cb is not None and cb != 0.0:
         return OPCODES["divc"], args[:1], cb
     return op, args, param
+
+
+def _is_identity(op: Opcode, param: Any) -> bool:
+    """Whether ``op(a; param)`` is ``a`` itself, bit for bit, for every float ``a``
+    (infinities, NaN and the sign of zero included): ``a * 1``, ``a / 1`` and
+    ``a + (-0.0)``. (``a + 0.0`` is not: it turns ``-0.0`` into ``0.0``.)"""
+    if op.name in ("mulc", "divc"):
+        return param == 1.0
+    return op.name == "addc" and param == 0.0 and math.copysign(1.0, param) < 0
 
 
 def _periodic_of_angle(op: Opcode, args: tuple[int, ...], param: Any,

@@ -12,13 +12,13 @@ The first layer of the data flow; it imports nothing else of implicitvox.
 from .nodes import Expr, constant, wrap, x, y, z
 from .coords import (Cylindrical, Spherical, cylindrical, elevation, phi, r, radius, rho,
                      spherical, theta)
-from .functions import (abs, acos, asin, atan, atan2, clip, cos, exp, floor, hypot, log, max,
-                        min, sin, sqrt, square, tan)
+from .functions import (abs, acos, affine, asin, atan, atan2, clip, cos, exp, floor, hypot, log,
+                        max, min, sin, sqrt, square, tan)
 from .sweeps import repeat, repeat_polar
 from .shape import AMBIGUOUS, EMPTY, FULL, ExprShape, Shape, as_shape
 
 __all__ = ["Expr", "constant", "wrap", "x", "y", "z", "Cylindrical", "Spherical", "cylindrical",
            "elevation", "phi", "r", "radius", "rho", "spherical", "theta", "repeat",
            "repeat_polar", "AMBIGUOUS", "EMPTY", "FULL", "ExprShape", "Shape", "as_shape",
-           "abs", "acos", "asin", "atan", "atan2", "clip", "cos", "exp", "floor", "hypot", "log",
-           "max", "min", "sin", "sqrt", "square", "tan"]
+           "abs", "acos", "affine", "asin", "atan", "atan2", "clip", "cos", "exp", "floor", "hypot",
+           "log", "max", "min", "sin", "sqrt", "square", "tan"]

@@ -1,5 +1,5 @@
 """DSL functions: ``sqrt, square, abs, exp, log, sin, cos, tan, atan, atan2,
-asin, acos, hypot, min, max, floor, clip``.
+asin, acos, hypot, min, max, floor, clip, affine``.
 
 Each returns an :class:`~implicitvox.expr.nodes.Expr`. ``min`` and ``max`` take any
 number of arguments (or one iterable) and fall back to Python's built-ins when
@@ -19,12 +19,12 @@ max(sqrt(x), 0.0)
 from __future__ import annotations
 
 import builtins
-from typing import Any
+from typing import Any, Sequence
 
 from .nodes import Expr, wrap
 
 __all__ = ["sqrt", "square", "abs", "exp", "log", "sin", "cos", "tan", "atan", "atan2",
-           "asin", "acos", "hypot", "min", "max", "floor", "clip"]
+           "asin", "acos", "hypot", "min", "max", "floor", "clip", "affine"]
 
 
 def _unary(op: str, a: Any) -> Expr:
@@ -138,3 +138,39 @@ def clip(a: Any, lo: Any, hi: Any) -> Expr:
     return Expr("max", (wrap(lo), Expr("min", (wrap(a), wrap(hi)))))
 
 
+
+
+def affine(coefficients: Sequence[float], terms: Sequence[Any], offset: float = 0.0) -> Any:
+    """``c[0] * t[0] + c[1] * t[1] + ... + offset``, summed left to right, with the
+    fewest operations: a term whose coefficient is 0 is left out (the function
+    does not depend on it), a coefficient 1 (-1) takes the term itself (negated),
+    and an offset 0 adds nothing.
+
+    Where the terms are finite, the floats are those of the full sum up to the
+    sign of a zero (adding a zero product changes no other value, and ``t * 1``
+    is ``t``); the tape is shorter and its enclosures are at least as tight (no
+    rounding after an operation that changes nothing). Transforms and planes
+    of CSG solids are written with it: a rotation by a right angle or a box's
+    face has mostly zero coefficients.
+
+    Examples
+    --------
+    >>> from implicitvox import x, y, z
+    >>> affine([1.0, 0.0, 0.0], [x, y, z], 2.5)
+    x + 2.5
+    >>> affine([0.0, -1.0, 3.0], [x, y, z])
+    -y + z * 3.0
+    >>> affine([0.0, 0.0], [x, y], 1.0)
+    1.0
+    """
+    result: Any = None
+    for c, t in zip(coefficients, terms):
+        c = float(c)
+        if c == 0.0:
+            continue
+        term = t if c == 1.0 else -t if c == -1.0 else t * c
+        result = term if result is None else result + term
+    offset = float(offset)
+    if result is None:
+        return wrap(offset)
+    return result + offset if offset != 0.0 else result

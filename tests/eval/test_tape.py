@@ -67,6 +67,27 @@ def test_constant_and_variable_outputs_broadcast():
     assert lo.shape == (5,) and hi[0] == 1.0
 
 
+def test_exact_identities_take_no_instruction_and_change_no_bit():
+    """``a * 1``, ``a / 1`` and ``a - 0`` are ``a`` for every float (signed zeros,
+    infinities, NaN, subnormals): no instruction, the same bits, no widening."""
+    X = np.array([-0.0, 0.0, 1.5, -2.0 ** -1074, np.inf, -np.inf, np.nan, 1e308, -3.25])
+    cases = [(x * 1.0, lambda a: a * 1.0), (1.0 * x, lambda a: 1.0 * a),
+             (x / 1.0, lambda a: a / 1.0), (x - 0.0, lambda a: a - 0.0),
+             (x + (-0.0), lambda a: a + -0.0), ((x - 0.0) * 1.0 / 1.0, lambda a: a)]
+    for expr, numpy_form in cases:
+        f = ivx.compile(expr)
+        assert names(f.tape) == [], expr
+        with np.errstate(all="ignore"):
+            assert np.array_equal(f(X, 0, 0).view(np.int64), numpy_form(X).view(np.int64)), expr
+        lo, hi = f.interval([0.1, 0, 0], [0.7, 0, 0])
+        assert lo[0] == 0.1 and hi[0] == 0.7            # not widened by a rounding
+    # a + 0.0 turns -0.0 into 0.0: it is no identity and stays
+    f = ivx.compile(x + 0.0)
+    assert names(f.tape) == ["addc"]
+    assert np.signbit(f(np.array([-0.0]), 0, 0)).tolist() == [False]
+    assert names(build_tape(ivx.sin(x * 1.0) * 2.0)) == ["sin", "mulc"]
+
+
 #: (expression, its fused centre, the same sum written in numpy)
 SPHERES = [
     (ivx.sqrt((x - 0.3) ** 2 + (y + 0.2) ** 2 + (z - 1e-3) ** 2), (0.3, -0.2, 1e-3),

@@ -113,3 +113,24 @@ def test_a_deep_expression_pickles_flat_and_shared():
     square = x * x
     shared = pickle.loads(pickle.dumps(square + square))
     assert shared.args[0] is shared.args[1]
+
+
+def test_affine_leaves_out_what_changes_nothing_and_keeps_the_floats():
+    """Zero coefficients are left out, 1 and -1 take the term itself, a zero offset
+    adds nothing: fewer instructions, the floats of the full sum (signed zeros aside)."""
+    from implicitvox.eval.tape import build_tape
+    rng = np.random.default_rng(3)
+    P = rng.uniform(-5, 5, (3, 5000))
+    P[:, :50] = 0.0
+    for _ in range(40):
+        c = rng.choice([0.0, 1.0, -1.0, 0.3, -2.75, 1e-300], size=3)
+        d = float(rng.choice([0.0, -0.0, 1.25]))
+        e = ivx.affine(c, (x, y, z), d)
+        full = ((c[0] * P[0] + c[1] * P[1]) + c[2] * P[2]) + d
+        got = ivx.compile(e)(*P)
+        assert np.array_equal(got, full), (c, d)        # == : 0.0 and -0.0 are equal
+        scaled = int(np.sum((c != 0) & (np.abs(c) != 1)))
+        adds = max(int(np.sum(c != 0)) - 1, 0) + (d != 0 and c.any())
+        negs = int(np.sum(c == -1.0))
+        assert len(build_tape(e).instructions) <= scaled + adds + negs, (c, d)
+    assert ivx.affine([0.0, 0.0, 0.0], (x, y, z), 2.0) == ivx.constant(2.0)
