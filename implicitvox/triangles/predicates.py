@@ -191,18 +191,22 @@ class FixedPlanes:
             for (u, v), prod in zip(pairs, (p1, p2, p3, p4, p5, p6)):
                 ok &= (np.abs(prod) >= _NORMAL) | (u == 0) | (v == 0)
         self.filtered = ok
+        #: per triangle, as rows: a (3), the normal (3), its weights (3) and
+        #: "filtered" (0 or 1): one gather per query (rows stay contiguous)
+        self._table = np.concatenate([a.T, self.normal.T, self.weight.T,
+                                      ok[None, :].astype(np.float64)]).astype(np.float64)
 
     def sign(self, which: np.ndarray, d: np.ndarray) -> np.ndarray:
         """Sign of ``orient3d(a[which], b[which], c[which], d)`` per row, exactly."""
-        a = self.a[which]
-        n, w = self.normal[which], self.weight[which]
+        a0, a1, a2, n0, n1, n2, w0, w1, w2, filtered = np.take(self._table, which, axis=1)
         with np.errstate(all="ignore"):
-            dx, dy, dz = d[:, 0] - a[:, 0], d[:, 1] - a[:, 1], d[:, 2] - a[:, 2]
-            det = n[:, 0] * dx + n[:, 1] * dy + n[:, 2] * dz
-            bound = _DET3_BOUND * (w[:, 0] * np.abs(dx) + w[:, 1] * np.abs(dy)
-                                   + w[:, 2] * np.abs(dz))
-            sure = (np.abs(det) > bound) & (bound > _TINY) & np.isfinite(bound) \
-                & self.filtered[which]
+            dx, dy, dz = d[:, 0] - a0, d[:, 1] - a1, d[:, 2] - a2
+            det = n0 * dx + n1 * dy + n2 * dz
+            np.abs(dx, out=dx)
+            np.abs(dy, out=dy)
+            np.abs(dz, out=dz)
+            bound = _DET3_BOUND * (w0 * dx + w1 * dy + w2 * dz)
+            sure = (np.abs(det) > bound) & (bound > _TINY) & np.isfinite(bound) & (filtered > 0)
             sign = np.sign(det).astype(np.int8)
         unsure = np.flatnonzero(~sure)
         if len(unsure):
