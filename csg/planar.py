@@ -419,9 +419,6 @@ class LinearExtrude(Solid):
         section = self._children[0].expr.remap(x=u, y=v)
         if (self.twist == 0 and np.all(self.scale_top == 1)) or self._children[0].bounds is None:
             return iv.max(section, z0 - z, z - (z0 + h))
-        # The solid lies within the cone (cylinder) of the section's reach: the sign is
-        # the same, but the intervals reject what the turned, rescaled section cannot
-        # (undoing a scale near 0 is unbounded: every box at a pointed top would be kept).
         # The solid lies within the annulus (cone) of the section's radii: the sign is the
         # same, but the intervals reject what the turned, rescaled section cannot (undoing
         # a scale near 0 is unbounded: every box at a pointed top would be kept).
