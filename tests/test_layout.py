@@ -43,8 +43,8 @@ IMPLICITVOX_ALL = [
     "utah_teapot", "linf", "linf_distance", "Voxels", "Grid", "Octree", "PointerOctree", "load",
     "mesh", "Shape", "EMPTY", "FULL", "AMBIGUOUS", "distance_field", "DistanceField", "load_field",
     "suitability", "Suitability",
-    "abs", "acos", "asin", "atan", "atan2", "clip", "cos", "exp", "floor", "hypot", "log",
-    "max", "min", "sin", "sqrt", "square", "tan",
+    "abs", "acos", "affine", "asin", "atan", "atan2", "clip", "cos", "exp", "floor", "hypot",
+    "log", "max", "min", "sin", "sqrt", "square", "tan",
 ]
 CSG_ALL = [
     "Solid", "Union", "Intersection", "Difference", "Complement", "Transformed", "ExprSolid",
