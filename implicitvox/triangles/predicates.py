@@ -50,33 +50,24 @@ def exact_integers(*columns: np.ndarray) -> list[np.ndarray]:
     row scaled by the same power of two (so signs of homogeneous polynomials
     are kept)."""
     v = np.stack([np.asarray(c, dtype=np.float64) for c in columns])
-    mant, expo = np.frexp(v)
-    ints = (mant * 2.0 ** 53).astype(np.int64)            # exact: |mant| < 1
-    expo = expo.astype(np.int64) - 53
-    zero = ints == 0
-    expo[zero] = np.iinfo(np.int64).max
-    low = expo.min(axis=0)
-    low[low == np.iinfo(np.int64).max] = 0
-    shift = np.where(zero, 0, expo - low)
-    out = np.left_shift(ints.astype(object), shift.astype(object))
-    return list(out)
+    return list(_integers_at(v, _lowest_exponent(v, axis=0)))
 
 
-def _lowest_exponent(*arrays: np.ndarray) -> int:
-    """The least power of two ``e`` such that every float of ``arrays`` is an
-    integer times ``2**e`` (0 when all are zero)."""
-    lows = []
-    for m in arrays:
-        mant, expo = np.frexp(m)
-        expo = expo[mant != 0]
-        if expo.size:
-            lows.append(int(expo.min()) - 53)
-    return min(lows, default=0)
+def _lowest_exponent(values: np.ndarray, axis=None):
+    """The least power of two ``e`` such that every float of ``values`` (along
+    ``axis``; all of them when None) is an integer times ``2**e``, 0 where all
+    are zero."""
+    mant, expo = np.frexp(values)
+    never = np.iinfo(np.int64).max
+    expo = np.where(mant != 0, expo.astype(np.int64) - 53, never)
+    low = expo.min(axis=axis)
+    return np.where(low == never, 0, low)
 
 
-def _integers_at(values: np.ndarray, low: int) -> np.ndarray:
+def _integers_at(values: np.ndarray, low) -> np.ndarray:
     """Finite floats as an object array of Python ints, in units of ``2**low``
-    (``low`` at most :func:`_lowest_exponent` of ``values``)."""
+    (``low`` at most :func:`_lowest_exponent` of ``values``; an array of them
+    broadcasts along the last axis)."""
     mant, expo = np.frexp(values)
     ints = (mant * 2.0 ** 53).astype(np.int64)            # exact: |mant| < 1
     shift = np.where(mant == 0, 0, expo.astype(np.int64) - 53 - low)
@@ -194,7 +185,7 @@ class FixedPlanes:
         #: per triangle, as rows: a (3), the normal (3), its weights (3) and
         #: "filtered" (0 or 1): one gather per query (rows stay contiguous)
         self._table = np.concatenate([a.T, self.normal.T, self.weight.T,
-                                      ok[None, :].astype(np.float64)]).astype(np.float64)
+                                      ok[None, :].astype(np.float64)])
 
     def sign(self, which: np.ndarray, d: np.ndarray) -> np.ndarray:
         """Sign of ``orient3d(a[which], b[which], c[which], d)`` per row, exactly."""
@@ -223,7 +214,7 @@ class FixedPlanes:
         """
         tris, row_tri = np.unique(which, return_inverse=True)
         a, b, c = self.a[tris], self.b[tris], self.c[tris]
-        low = _lowest_exponent(a, b, c, d)
+        low = int(_lowest_exponent(np.concatenate([m.ravel() for m in (a, b, c, d)])))
         A, B, C, D = (_integers_at(m, low) for m in (a, b, c, d))
         U, V = B - A, C - A
         N = np.stack([U[:, 1] * V[:, 2] - U[:, 2] * V[:, 1],
