@@ -36,13 +36,15 @@ import functools
 import math
 import shutil
 import subprocess
+import warnings
 from typing import Optional
 
 import numpy as np
 
 from .facets import fragments
 
-__all__ = ["text_contours", "text_polygon", "find_font", "DEFAULT_FONT", "MAX_GLYPHS"]
+__all__ = ["text_contours", "text_polygon", "find_font", "FontFallbackWarning", "DEFAULT_FONT",
+           "MAX_GLYPHS"]
 
 #: the font OpenSCAD 2021.01 uses when ``font`` is empty
 DEFAULT_FONT = "Liberation Sans:style=Regular"
@@ -51,6 +53,16 @@ MAX_GLYPHS = 100_000
 _CHAR_SIZE = 100_000          # OpenSCAD's FT_Set_Char_Size (26.6 points), at 100 dpi
 _POINT_SCALE = 1000.0         # FreetypeRenderer::scale: outline points / 1000
 _POSITION_SCALE = 64.0 * 16.0  # GlyphData: HarfBuzz positions / 64 / 16
+
+
+class FontFallbackWarning(UserWarning):
+    """The font a text asks for is not installed: fontconfig gave another family.
+
+    OpenSCAD takes fontconfig's fallback too, so the text is still drawn, but its
+    outlines (and voxels) are those of the fallback font. The test suite turns this
+    warning into an error, so a machine without ``fonts-liberation`` fails the text
+    tests with a message that names the missing font.
+    """
 
 
 @functools.lru_cache(maxsize=64)
@@ -62,17 +74,30 @@ def find_font(font: str = "") -> tuple[str, int]:
     ------
     ValueError
         fontconfig's ``fc-match`` is not installed, or matches no font file.
+
+    Warns
+    -----
+    FontFallbackWarning
+        fontconfig has no font of the family asked for and gives its fallback
+        (once per font name and process).
     """
     name = font.strip() or DEFAULT_FONT
     if shutil.which("fc-match") is None:
         raise ValueError("text needs fontconfig's fc-match to find its font "
                          "(Debian: apt-get install fontconfig fonts-liberation)")
-    found = subprocess.run(["fc-match", "--format=%{file}\n%{index}", name],
+    found = subprocess.run(["fc-match", "--format=%{file}\n%{index}\n%{family}", name],
                            capture_output=True, text=True, timeout=30)
     lines = found.stdout.splitlines()
     if found.returncode != 0 or not lines or not lines[0]:
         raise ValueError(f"text: fontconfig finds no font for {name!r}")
     index = int(lines[1]) if len(lines) > 1 and lines[1].isdigit() else 0
+    asked = name.split(":")[0].strip()
+    families = [f.strip().lower() for f in (lines[2] if len(lines) > 2 else "").split(",")]
+    if asked and asked.lower() not in families:
+        hint = " (Debian: apt-get install fonts-liberation)" if "liberation" in asked.lower() \
+            else ""
+        warnings.warn(f"text: font {asked!r} is not installed; fontconfig gives {lines[0]} "
+                      f"instead{hint}", FontFallbackWarning, stacklevel=3)
     return lines[0], index
 
 

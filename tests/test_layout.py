@@ -239,3 +239,52 @@ def test_the_layer_checks_can_fail(tmp_path, monkeypatch):
     cyc.write_text("from ..io import cli2\n")
     with pytest.raises(pytest.fail.Exception, match="import cycle"):
         test_no_import_cycles()
+
+
+#: tracked files allowed over ``MAX_TRACKED_BYTES``: test data, each with its size in bytes
+LARGE_TEST_DATA = {
+    "tests/openscad/lettering.stl": 1154340,   # OpenSCAD's own STL export of lettering.scad
+}
+MAX_TRACKED_BYTES = 1 << 20
+#: endings of archives, wheels and binaries that never belong in the repository
+ARCHIVE_ENDINGS = (".whl", ".zip", ".tar", ".tar.gz", ".tgz", ".tar.bz2", ".tar.xz", ".gz",
+                   ".bz2", ".xz", ".7z", ".rar", ".egg", ".so", ".dll", ".dylib", ".exe",
+                   ".pyc", ".jar")
+
+
+def _tracked_files() -> list[str]:
+    out = subprocess.run(["git", "ls-files", "-z"], capture_output=True, check=True, cwd=ROOT)
+    return [p for p in out.stdout.decode().split("\0") if p]
+
+
+def _unwanted(paths: list[str]) -> list[str]:
+    wrong = []
+    for rel in paths:
+        path = ROOT / rel
+        if rel.lower().endswith(ARCHIVE_ENDINGS):
+            wrong.append(f"{rel} is an archive or binary: it does not belong in the repository")
+        elif path.is_file() and path.stat().st_size > MAX_TRACKED_BYTES:
+            size = path.stat().st_size
+            if LARGE_TEST_DATA.get(rel) != size:
+                wrong.append(f"{rel} has {size} bytes, over {MAX_TRACKED_BYTES}: name it in "
+                             f"LARGE_TEST_DATA with its size if it is test data")
+    return wrong
+
+
+@pytest.mark.skipif(not (ROOT / ".git").exists(), reason="not a git checkout: nothing is tracked")
+def test_no_archive_and_no_large_file_is_tracked():
+    wrong = _unwanted(_tracked_files())
+    assert not wrong, "\n".join(wrong)
+
+
+def test_the_tracked_file_check_can_fail(tmp_path, monkeypatch):
+    """A wheel and an unlisted large file are caught; listed test data of its size is not."""
+    monkeypatch.setattr(sys.modules[__name__], "ROOT", tmp_path)
+    (tmp_path / "numpy-2.0-cp311.whl").write_bytes(b"PK")
+    (tmp_path / "big.bin").write_bytes(b"\0" * (MAX_TRACKED_BYTES + 1))
+    (tmp_path / "tests" / "openscad").mkdir(parents=True)
+    (tmp_path / "tests/openscad/lettering.stl").write_bytes(b"\0" * 1154340)
+    wrong = _unwanted(["numpy-2.0-cp311.whl", "big.bin", "tests/openscad/lettering.stl"])
+    assert len(wrong) == 2
+    assert "numpy-2.0-cp311.whl is an archive" in wrong[0]
+    assert "big.bin has" in wrong[1]

@@ -42,3 +42,13 @@ def test_the_table_splicer_replaces_only_marked_tables():
     assert tables.splice(text, {"x": "new\n"}) == \
         "a\n<!-- table:x -->\nnew\n<!-- /table:x -->\nb <!-- table:y -->\n"
     assert tables.readme_tables(text) == {"x": "old\n"}
+
+
+def test_readme_names_every_debian_package_ci_installs():
+    """A fresh machine set up from the README has what CI installs (the fonts too)."""
+    import re
+    ci = (ROOT / ".ci" / "run").read_text()
+    packages = re.search(r"for pkg in ([^;]+);", ci).group(1).split()
+    readme = " ".join((ROOT / "README.md").read_text().split())
+    line = re.search(r"`apt-get install ([^`]+)`", readme).group(1).split()
+    assert sorted(packages) == sorted(line), (packages, line)

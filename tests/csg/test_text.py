@@ -80,3 +80,14 @@ def test_strings_keep_non_ascii_and_decode_openscads_escapes():
     direct = text_polygon("☼", size=50)
     lo, hi = np.asarray(read.bounds)
     assert np.allclose(lo, [*direct.points.min(0), 0]) and np.allclose(hi, [*direct.points.max(0), 1])
+
+
+def test_a_missing_font_is_named_in_a_warning():
+    from csg.text import FontFallbackWarning, find_font
+    find_font.cache_clear()
+    with pytest.warns(FontFallbackWarning, match="'No Such Font Family' is not installed"):
+        path, _ = find_font("No Such Font Family:style=Bold")
+    assert path                                      # fontconfig's fallback is still drawn
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        find_font("Liberation Sans:style=Bold")      # installed: no warning
