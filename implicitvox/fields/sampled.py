@@ -27,7 +27,7 @@ from .. import validate
 from ..expr.nodes import Expr
 from ..expr.shape import as_shape
 from ..linf.mesh import TriangleMesh
-from ..octree.budget import memory_budget, refuse_over_budget
+from ..octree.run import Run
 from ..triangles.inputs import as_triangles
 from ..voxelizers.implicit import voxelize
 from ..voxelizers.mesh import voxelize_mesh
@@ -126,26 +126,25 @@ def distance_field(shape: Any, resolution: Union[int, tuple[int, int, int], None
         reconstructed near those places are off (Bærentzen §4-§6).
     """
     norm = validate.choice(norm, "norm", NORMS)
-    workers, executor = validate.workers(workers), validate.executor(executor)
+    run = Run.of(max_memory=max_memory, progress=progress, workers=workers, executor=executor)
     band = None if band is None else validate.int_in(band, "band", 1, MAX_BAND)
-    budget = memory_budget(max_memory)
-    report = progress if progress is not None else (lambda share: None)
     mesh = _as_mesh(shape)
     t0 = time.perf_counter()
+    first = run.part(0.0, 0.2)
     if mesh is not None:
         # the triangles with their shared vertices again (the fill needs the connectivity)
         vertices, corners = np.unique(mesh.tri.reshape(-1, 3), axis=0, return_inverse=True)
         vox = voxelize_mesh((vertices, corners.reshape(-1, 3)),
                             resolution, bounds=bounds, voxel_size=voxel_size,
-                            interior=mesh.closed, max_memory=budget,
-                            progress=lambda s: report(0.2 * s), workers=workers,
-                            executor=executor)
+                            interior=mesh.closed, max_memory=first.budget,
+                            progress=first.progress, workers=first.workers,
+                            executor=first.executor)
         target = mesh
     else:
         target = as_shape(shape)
         vox = voxelize(target, resolution, bounds=bounds, voxel_size=voxel_size, interior=True,
-                       max_memory=budget, progress=lambda s: report(0.2 * s), workers=workers,
-                       executor=executor)
+                       max_memory=first.budget, progress=first.progress,
+                       workers=first.workers, executor=first.executor)
     grid = vox.grid
     h = np.asarray(grid.voxel_size)
     tol = float(h.min()) * TOLERANCE if tolerance is None else \
@@ -154,8 +153,8 @@ def distance_field(shape: Any, resolution: Union[int, tuple[int, int, int], None
     surface = vox.coords()
     keys, active = band_bricks(surface, band, grid.shape) if band is not None else \
         all_bricks(grid.shape)
-    refuse_over_budget(estimate_bytes(len(keys)), budget,
-                       f"a distance field of {len(keys):,} bricks at {grid.shape}")
+    run.refuse(estimate_bytes(len(keys)),
+               f"a distance field of {len(keys):,} bricks at {grid.shape}")
     # where the certified search looks first (it widens where no zero is proved)
     reach = _FIRST_REACH if band is None else band + 1
     limit = reach * float(h.max()) * (math.sqrt(3) if norm == "euclidean" else 1.0)
@@ -165,9 +164,8 @@ def distance_field(shape: Any, resolution: Union[int, tuple[int, int, int], None
         spec.boxes = _surface_boxes(vox)
     kernel = spec.kernel
     coords = brick_coords(keys)[active]
-    values_band, errors_band, used = band_distances(
-        spec, grid, weights, coords, workers=workers, executor=executor,
-        progress=lambda s: report(0.2 + 0.8 * s))
+    values_band, errors_band, used = band_distances(spec, grid, weights, coords,
+                                                    run.part(0.2, 1.0))
     field = _assemble(grid, norm, band, keys, active, values_band, errors_band, kernel.kind, vox)
     field.signed = mesh is None or mesh.closed
     field.metadata["suitable"] = _check_suitability(target, vox) if check_suitability and \
@@ -179,7 +177,7 @@ def distance_field(shape: Any, resolution: Union[int, tuple[int, int, int], None
                       "the refinement resolves", UserWarning, stacklevel=2)
     field.metadata.update({"seconds": time.perf_counter() - t0, "surface_voxels": vox.count,
                            "tolerance": tol, "bricks": len(keys), "workers": used})
-    report(1.0)
+    run.report(1.0)
     return field
 
 

@@ -10,14 +10,15 @@ any number of workers.
 from __future__ import annotations
 
 import functools
-from typing import Any, Callable, Optional
+from typing import Any, Optional
 
 import numpy as np
 
 from ..eval.function import Function
 from ..linf.mesh import TriangleMesh
 from ..octree.grid import Grid
-from ..parallel import Job, farm, plan_workers
+from ..octree.run import Run
+from ..parallel import Job, farm
 from .certified import certified_distances
 from .kernels import Kernel, choose_kernel
 
@@ -84,20 +85,18 @@ class SamplesJob(Job):
 
 
 def band_distances(spec: DistanceKernel, grid: Grid, weights: np.ndarray, coords: np.ndarray,
-                   *, workers: Optional[int] = None, executor: Any = None,
-                   progress: Optional[Callable[[float], Any]] = None
-                   ) -> tuple[np.ndarray, np.ndarray, int]:
-    """Values and errors at the centres of voxels ``coords`` (n, 3), and the
-    workers used (1: serial, here)."""
+                   run: Run) -> tuple[np.ndarray, np.ndarray, int]:
+    """Values and errors at the centres of voxels ``coords`` (n, 3), on the
+    ``run``'s workers, and the workers used (1: serial, here)."""
     values = np.empty(len(coords))
     errors = np.empty(len(coords))
     chunk = CHUNK[spec.cost]
     starts = range(0, len(coords), chunk)
-    n = plan_workers(workers, executor, len(coords) * COST[spec.cost])
-    if (n > 1 or executor is not None) and len(starts) > 1:
+    n = run.workers_for(len(coords) * COST[spec.cost])
+    if (n > 1 or run.executor is not None) and len(starts) > 1:
         job = SamplesJob(spec, grid, weights)
         for i, (v, e) in farm(job, [coords[s:s + chunk] for s in starts], workers=n,
-                              executor=executor, progress=progress,
+                              executor=run.executor, progress=run.progress,
                               weights=[min(chunk, len(coords) - s) for s in starts],
                               what=f"computing distances at {grid.shape}"):
             values[starts[i]:starts[i] + chunk], errors[starts[i]:starts[i] + chunk] = v, e
@@ -105,6 +104,5 @@ def band_distances(spec: DistanceKernel, grid: Grid, weights: np.ndarray, coords
     for s in starts:
         part = slice(s, s + chunk)
         values[part], errors[part] = spec.kernel(grid.centers(coords[part]), weights)
-        if progress is not None:
-            progress(min(1.0, (s + chunk) / max(len(coords), 1)))
+        run.report(min(1.0, (s + chunk) / max(len(coords), 1)))
     return values, errors, 1

@@ -26,24 +26,21 @@ import numpy as np
 from .. import validate
 from ..eval.function import Function
 from ..expr.shape import as_shape, exact_classifier, expression_is_exact, voxel_classifier
-from ..octree.budget import memory_budget, refuse_over_budget
 from ..octree.grid import Grid, grid_of
-from ..octree.guard import MemoryGuard
 from ..octree.morton import MAX_BITS
-from ..octree.subdivide import RECHECK, subdivide
+from ..octree.pilot import Estimate, estimate_surface
+from ..octree.run import Run
 from ..octree.subtrees import subdivide_in_parallel
-from ..parallel import plan_workers
+from ..octree.surface import SurfaceOptions
 from ..version import __version__
 from .adaptive import BYTES_PER_CELL, adaptive_grid
 from .contour import dual_contour
 from .manifold import split_nonmanifold
 
-__all__ = ["mesh", "mesh_grid", "estimate_mesh_memory", "REFINE"]
+__all__ = ["mesh", "mesh_grid", "estimate_meshing_memory", "REFINE"]
 
 #: levels below the tolerance's cells that complex cells may be split to
 REFINE = 4
-#: the pilot voxelization's depth for the memory estimate
-_PILOT_DEPTH = 6
 #: leaves per surface voxel of the tolerance level, for the estimate (refined
 #: complex cells and the contouring's arrays)
 _LEAVES_PER_VOXEL = 2
@@ -122,21 +119,20 @@ def mesh(shape: Any, tolerance: Optional[float] = None,
         tol = validate.positive_number(tolerance, "tolerance")
         voxel_size = tol / math.sqrt(3) * (1 - 2.0 ** -40)
     refine = validate.int_in(refine, "refine", 0, 12)
+    run = Run.of(max_memory=max_memory, progress=progress, workers=workers, executor=executor)
+    prune = validate.boolean(prune, "prune")
     grid = grid_of(getattr(shape, "bounds", None), bounds, resolution, voxel_size)
     if grid.depth + refine > MAX_BITS:
         raise ValueError(f"the grid {grid.shape} with refine={refine} needs "
                          f"{grid.depth + refine} octree levels, over the {MAX_BITS} there are; "
                          "raise tolerance or lower refine")
-    return mesh_grid(shape, grid, refine=refine, progress=progress,
-                     budget=memory_budget(max_memory), prune=validate.boolean(prune, "prune"),
-                     workers=validate.workers(workers), executor=validate.executor(executor))
+    return mesh_grid(shape, grid, run, refine=refine, prune=prune)
 
 
-def mesh_grid(shape: Any, grid: Grid, *, refine: int = REFINE,
-              progress: Optional[Callable[[float], Any]] = None, budget: int,
-              prune: bool = True, workers: Optional[int] = None, executor: Any = None) -> Any:
-    """:func:`mesh` on a given grid (its voxels are the largest cells), under a
-    byte ``budget``; :meth:`implicitvox.Voxels.to_mesh` uses it."""
+def mesh_grid(shape: Any, grid: Grid, run: Run, *, refine: int = REFINE,
+              prune: bool = True) -> Any:
+    """:func:`mesh` on a given grid (its voxels are the largest cells), under the
+    ``run``'s budget, progress and workers; :meth:`implicitvox.Voxels.to_mesh` uses it."""
     import pyvista as pv
 
     shape = as_shape(shape)
@@ -148,28 +144,25 @@ def mesh_grid(shape: Any, grid: Grid, *, refine: int = REFINE,
                          "true curves), or voxelize the solid")
     func = Function(shape.expr)
     exact, exact_voxels = exact_classifier(shape), voxel_classifier(shape)
-    estimated, need = estimate_mesh_memory(shape, grid, prune)
+    estimate, estimated, need = estimate_meshing_memory(shape, grid, prune)
     what = f"meshing at {grid.shape}"
-    refuse_over_budget(need, budget, f"{what} (~{estimated:,} cells)")
-    guard = MemoryGuard(budget, what, BYTES_PER_CELL, estimated_voxels=estimated)
+    run.refuse(need, f"{what} (~{estimated:,} cells; {estimate.explained()})")
+    guard = run.guard(what, BYTES_PER_CELL, estimated=estimated)
     t0 = time.perf_counter()
-    share = progress if progress is not None else (lambda s: None)
-    workers = plan_workers(workers, executor, estimated / _LEAVES_PER_VOXEL)
+    workers = run.workers_for(estimate.voxels)
     split = None
-    if workers > 1 or executor is not None:
-        options = {"interior": False, "normals": False, "mean_value": False, "subvoxel": 0,
-                   "recheck": RECHECK, "prune": prune}
-        split = subdivide_in_parallel(shape, func, grid, options, workers=workers,
-                                      executor=executor, progress=lambda s: share(0.3 * s),
-                                      budget=budget, per_voxel=BYTES_PER_CELL, guard=guard,
-                                      what=what, tapes=True)
+    if workers > 1 or run.executor is not None:
+        split = subdivide_in_parallel(shape, func, grid, SurfaceOptions(prune=prune),
+                                      run.part(0.0, 0.3), workers=workers,
+                                      per_voxel=BYTES_PER_CELL, guard=guard, what=what,
+                                      tapes=True)
     agrid = adaptive_grid(func, grid, refine, exact=exact, exact_voxels=exact_voxels,
-                          progress=lambda s: share(0.6 * s), guard=guard, prune=prune,
+                          progress=run.part(0.0, 0.6).progress, guard=guard, prune=prune,
                           voxels=None if split is None else split.result)
     h = max(grid.voxel_size)
     contour = dual_contour(func, agrid, bound=h * math.sqrt(3),
-                           progress=lambda s: share(0.6 + 0.35 * s))
-    share(1.0)
+                           progress=run.part(0.6, 0.95).progress)
+    run.report(1.0)
     points, triangles, non_manifold = split_nonmanifold(contour.points, contour.faces)
     faces = np.hstack([np.full((len(triangles), 1), 3, dtype=np.int64), triangles])
     out = pv.PolyData(points, faces=faces.ravel()) if len(triangles) else pv.PolyData()
@@ -191,17 +184,14 @@ def mesh_grid(shape: Any, grid: Grid, *, refine: int = REFINE,
     return out
 
 
-def estimate_mesh_memory(shape: Any, grid: Grid, prune: bool = True) -> tuple[int, int]:
-    """Estimated leaves and peak bytes of :func:`mesh_grid` on ``grid``: a pilot
-    voxelization at depth ``min(depth, 6)``, grown by Stolte's factor of 4 per
-    level (§4.1.3), times the leaves per surface voxel and the bytes per leaf."""
+def estimate_meshing_memory(shape: Any, grid: Grid, prune: bool = True
+                            ) -> tuple[Estimate, int, int]:
+    """The pilot's estimate (:func:`implicitvox.octree.pilot.estimate_surface`, with
+    the shape's exact box test), and the leaves and peak bytes of :func:`mesh_grid`
+    on ``grid``: the surface voxels times the leaves per surface voxel and the bytes
+    per leaf."""
     shape = as_shape(shape)
-    func = Function(shape.expr)
-    exact = exact_classifier(shape)
-    depth = grid.depth
-    pilot_depth = min(depth, _PILOT_DEPTH)
-    pilot = grid.coarser(depth - pilot_depth)
-    found = len(subdivide(func, pilot, recheck=0.0, prune=prune, exact=exact).codes)
-    cells = float(np.prod(grid.shape, dtype=np.float64))
-    leaves = int(min(found * 4.0 ** (depth - pilot_depth), cells) * _LEAVES_PER_VOXEL)
-    return leaves, leaves * BYTES_PER_CELL
+    estimate = estimate_surface(Function(shape.expr), grid, prune=prune,
+                                exact=exact_classifier(shape))
+    leaves = int(estimate.voxels * _LEAVES_PER_VOXEL)
+    return estimate, leaves, leaves * BYTES_PER_CELL

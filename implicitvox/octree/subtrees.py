@@ -36,7 +36,7 @@ from __future__ import annotations
 
 import functools
 from dataclasses import dataclass, field
-from typing import Any, Callable, Optional
+from typing import Any, Optional
 
 import numpy as np
 
@@ -46,9 +46,10 @@ from . import morton
 from .grid import Grid
 from .guard import MemoryGuard
 from .store import Octree, subtree_masks
+from .run import Run
 from .subdivide import Subdivision
 from ..parallel import PIECES_PER_WORKER, Job, farm, pieces_for, split_evenly
-from .surface import subdivide_voxels, surface_payload
+from .surface import SurfaceOptions, subdivide_voxels, surface_payload
 
 __all__ = ["SubtreeJob", "SubtreeResult", "ParallelSubdivision", "subdivide_in_parallel",
            "parallel_bytes",
@@ -88,11 +89,11 @@ class SubtreeResult:
 class SubtreeJob(Job):
     """The subdivision of subtrees at ``level``, shared by every piece of one run."""
 
-    def __init__(self, shape: Any, func: Function, grid: Grid, options: dict, level: int,
-                 budget: int, per_voxel: int, what: str, tapes: bool = False):
+    def __init__(self, shape: Any, func: Function, grid: Grid, options: SurfaceOptions,
+                 level: int, budget: int, per_voxel: int, what: str, tapes: bool = False):
         super().__init__()
         self.tapes = tapes
-        self.shape, self.func, self.grid, self.options = shape, func, grid, dict(options)
+        self.shape, self.func, self.grid, self.options = shape, func, grid, options
         self.level, self.budget, self.per_voxel, self.what = level, int(budget), per_voxel, what
 
     @functools.cached_property
@@ -107,7 +108,7 @@ class SubtreeJob(Job):
         guard = MemoryGuard(self.budget, f"{self.what} (a worker)", self.per_voxel)
         result = subdivide_voxels(self.func, self.grid, self.options, self.prepared_exact,
                                   start=(self.level, coords), guard=guard)
-        payload = surface_payload(self.func, self.grid, result, self.options["normals"])
+        payload = surface_payload(self.func, self.grid, result, self.options.normals)
         interior = {lvl: morton.encode(c) for lvl, c in result.interior.items()}
         count = len(result.codes)
         if self.tapes:
@@ -149,16 +150,16 @@ def parallel_bytes(voxels: int, per_voxel: int, working: int, workers: int) -> i
     return int(voxels * per_voxel + workers * (working + share))
 
 
-def subdivide_in_parallel(shape: Any, func: Function, grid: Grid, options: dict, *,
-                          workers: int, executor: Any = None,
-                          progress: Optional[Callable[[float], Any]] = None,
+def subdivide_in_parallel(shape: Any, func: Function, grid: Grid, options: SurfaceOptions,
+                          run: Run, *, workers: int,
                           start: Optional[tuple[int, np.ndarray]] = None,
-                          budget: int, per_voxel: int, guard: Optional[MemoryGuard] = None,
+                          per_voxel: int, guard: Optional[MemoryGuard] = None,
                           what: str = "voxelizing", tapes: bool = False,
                           estimated: Optional[float] = None
                           ) -> Optional["ParallelSubdivision"]:
     """The serial run's octree, interior and boxes evaluated, computed by
-    ``workers`` processes or ``executor``.
+    ``workers`` processes or the ``run``'s executor, under its budget and
+    reporting to its progress hook.
 
     Returns None when the octree is too shallow to split (fewer than
     :data:`MIN_LEVELS_BELOW` levels below level 1): the caller runs serially.
@@ -171,7 +172,8 @@ def subdivide_in_parallel(shape: Any, func: Function, grid: Grid, options: dict,
     ``estimated``: the surface voxels expected, which set the number of pieces
     (:func:`implicitvox.parallel.pieces_for`; default the most).
     """
-    s = options["subvoxel"]
+    executor, budget = run.executor, run.budget
+    s = options.subvoxel
     depth = grid.depth + s                     # levels of the grid subdivided
     exact = (exact_classifier(shape), voxel_classifier(shape))
     pieces_wanted = PIECES_PER_WORKER * workers if estimated is None else \
@@ -210,7 +212,7 @@ def subdivide_in_parallel(shape: Any, func: Function, grid: Grid, options: dict,
     parts: dict[int, SubtreeResult] = {}          # by piece: merged in Morton order
     for index, part in farm(job, [pending[a:b] for a, b in ranges], workers=workers,
                             executor=executor, weights=[b - a for a, b in ranges],
-                            progress=progress, what=what):
+                            progress=run.progress, what=what):
         parts[index] = part
         if tapes:                                  # else the codes stay in the workers
             codes.append(part.codes)

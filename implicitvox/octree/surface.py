@@ -6,20 +6,57 @@ classify, map sub-voxels and compute normals with the same code.
 """
 from __future__ import annotations
 
+from dataclasses import dataclass
 from typing import Any, Optional
 
 import numpy as np
 
 from .. import batches
+from .. import validate
 from ..eval.function import Function
 from ..eval.gradient import evaluate_gradients
 from . import morton
 from .grid import Grid
 from .guard import MemoryGuard
-from .subdivide import Subdivision, subdivide
+from .morton import MAX_BITS
+from .subdivide import RECHECK, Subdivision, subdivide
 
-__all__ = ["subdivide_voxels", "interior_from_subvoxels", "voxel_normals", "unit_vectors",
-           "surface_payload"]
+__all__ = ["SurfaceOptions", "subdivide_voxels", "interior_from_subvoxels", "voxel_normals",
+           "unit_vectors", "surface_payload"]
+
+
+@dataclass(frozen=True)
+class SurfaceOptions:
+    """The options of the voxelizer's subdivision, named as :func:`implicitvox.voxelize`'s
+    parameters (its docstring says what each does); :meth:`of` checks them.
+
+    >>> SurfaceOptions.of(subvoxel=2).subvoxel
+    2
+    """
+
+    interior: bool = False
+    normals: bool = False
+    mean_value: bool = False
+    subvoxel: int = 0
+    recheck: float = RECHECK
+    prune: bool = True
+
+    @classmethod
+    def of(cls, *, interior: Any = False, normals: Any = False, mean_value: Any = False,
+           subvoxel: Any = 0, recheck: Any = RECHECK, prune: Any = True) -> "SurfaceOptions":
+        """The options, each checked (``ValueError`` naming the parameter)."""
+        return cls(interior=validate.boolean(interior, "interior"),
+                   normals=validate.boolean(normals, "normals"),
+                   mean_value=validate.boolean(mean_value, "mean_value"),
+                   subvoxel=validate.int_in(subvoxel, "subvoxel", 0, 4),
+                   recheck=validate.number_in(recheck, "recheck", 0.0, 4.0),
+                   prune=validate.boolean(prune, "prune"))
+
+    def check_depth(self, grid: Grid) -> None:
+        """``ValueError`` when the grid's levels and the sub-voxel levels pass the octree's."""
+        if grid.depth + self.subvoxel > MAX_BITS:
+            raise ValueError(f"resolution {grid.shape} with subvoxel={self.subvoxel} exceeds "
+                             f"the octree's {MAX_BITS} levels")
 
 _NORMALS_CHUNK = batches.NORMALS
 
@@ -59,7 +96,7 @@ def surface_payload(func: Function, grid: Grid, result: Subdivision, normals: bo
     return {"normals": voxel_normals(func, grid, result.surface, result.tapes)}
 
 
-def subdivide_voxels(func: Function, grid: Grid, options: dict, exact: tuple,
+def subdivide_voxels(func: Function, grid: Grid, options: SurfaceOptions, exact: tuple,
                      progress: Any = None, start: Any = None, guard: Optional[MemoryGuard] = None,
                      until_level: Optional[int] = None) -> Subdivision:
     """:func:`implicitvox.octree.subdivide.subdivide` with the voxelizer's
@@ -68,12 +105,12 @@ def subdivide_voxels(func: Function, grid: Grid, options: dict, exact: tuple,
     ``until_level`` (at most ``grid.depth``) stops there and returns the
     pending subtrees (:attr:`Subdivision.pending`, levels of the grid
     subdivided)."""
-    s = options["subvoxel"]
+    s = options.subvoxel
     exact_boxes, exact_voxels = exact
     result = subdivide(func, grid.finer(s) if s else grid, start=start,
-                       interior=options["interior"], exact=exact_boxes, progress=progress,
-                       mean_value=options["mean_value"], exact_voxels=exact_voxels,
-                       recheck=options["recheck"], guard=guard, prune=options["prune"],
+                       interior=options.interior, exact=exact_boxes, progress=progress,
+                       mean_value=options.mean_value, exact_voxels=exact_voxels,
+                       recheck=options.recheck, guard=guard, prune=options.prune,
                        leaf_level=grid.depth, until_level=until_level)
     if not s:
         return result

@@ -41,6 +41,7 @@ import multiprocessing
 import os
 import pickle
 import threading
+import time
 from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 from concurrent.futures.process import BrokenProcessPool
 from typing import Any, Callable, Iterator, Optional, Sequence
@@ -48,7 +49,8 @@ from typing import Any, Callable, Iterator, Optional, Sequence
 from .jobs import Job, run_piece, run_stored_piece, store_job
 from .plan import is_dask_client
 
-__all__ = ["farm", "WorkerError", "pool_context", "shutdown_pools", "SCATTER_BYTES"]
+__all__ = ["farm", "WorkerError", "pool_context", "shutdown_pools", "SCATTER_BYTES",
+           "OWNER_CHECK_SECONDS"]
 
 #: a job pickled larger than this is scattered to Dask's workers once; a smaller one
 #: travels with each task (Dask warns of task graphs past 10 MB: 16 pieces stay far below)
@@ -175,16 +177,53 @@ def _remove(path: str) -> None:
         pass
 
 
-#: the pools kept between runs, by their number of workers
+#: the pools kept between runs, by their number of workers (this process's own: a
+#: forked child forgets its parent's, :func:`_forget_inherited_pools`)
 _POOLS: dict = {}
+#: a forked child's copies of its parent's pools: never used, never shut down (their
+#: processes and threads are the parent's), only kept from the garbage collector, whose
+#: clean-up would write to the parent's wake-up pipe
+_INHERITED: list = []
+#: seconds between a worker's checks that the process that started it is alive
+OWNER_CHECK_SECONDS = 0.2
 
 
 def _shared_pool(workers: int):
     """The pool of ``workers`` processes kept for this process's runs (started on
-    first use, by :func:`pool_context`'s method), and its key."""
+    first use, by :func:`pool_context`'s method), and its key. Its workers exit on
+    their own when this process ends, however it ends (:func:`_exit_with_owner`)."""
     if workers not in _POOLS:
-        _POOLS[workers] = ProcessPoolExecutor(max_workers=workers, mp_context=pool_context())
+        _POOLS[workers] = ProcessPoolExecutor(max_workers=workers, mp_context=pool_context(),
+                                              initializer=_exit_with_owner)
     return _POOLS[workers], workers
+
+
+def _forget_inherited_pools() -> None:
+    """In a forked child: the pools copied from the parent are the parent's; the
+    child starts its own on its first parallel run."""
+    _INHERITED.extend(_POOLS.values())
+    _POOLS.clear()
+
+
+if hasattr(os, "register_at_fork"):
+    os.register_at_fork(after_in_child=_forget_inherited_pools)
+
+
+def _exit_with_owner() -> None:
+    """A pool worker's initializer: a daemon thread that ends the worker as soon as
+    the process that started it is gone (its parent changes: the owner died, or the
+    forkserver that started it did, which ends with the owner). ``atexit`` is not
+    enough: an owner that leaves by ``os._exit`` (a forked child of a test runner or
+    of ``multiprocessing``) or by a signal runs none, and its workers would keep the
+    pipes they inherited open."""
+    parent = os.getppid()
+
+    def watch() -> None:
+        while os.getppid() == parent:
+            time.sleep(OWNER_CHECK_SECONDS)
+        os._exit(0)
+
+    threading.Thread(target=watch, name="implicitvox-owner-watch", daemon=True).start()
 
 
 def shutdown_pools() -> None:

@@ -20,15 +20,12 @@ import numpy as np
 
 from .. import validate
 from ..triangles.bezier import BezierPatch, bezier_triangles
-from ..triangles.pairs import surface_codes
 from ..triangles.tribox import Triangles
-from ..octree.grid import Grid
+from ..octree.grid import Grid, grid_of
+from ..octree.run import Run
 from ..octree.store import Octree
 from ..octree.voxels import Voxels
-from ..octree.grid import grid_of
-from ..octree.budget import memory_budget, refuse_over_budget
-from .mesh import estimate_mesh_memory, estimate_mesh_voxels, nearest_triangle_normals
-from ..parallel import plan_workers
+from .mesh import nearest_triangle_normals, triangle_surface
 
 __all__ = ["voxelize_bezier", "BezierSource"]
 
@@ -37,18 +34,18 @@ class BezierSource:
     """The patches a :class:`Voxels` came from (its
     :class:`~implicitvox.octree.voxels.VoxelSource`)."""
 
-    def __init__(self, patches: list[BezierPatch], flatness: float,
-                 parallel: tuple[Optional[int], Any] = (1, None)):
+    def __init__(self, patches: list[BezierPatch], flatness: float, run: Run):
         self.patches = patches
         self.flatness = flatness
-        #: ``(workers, executor)`` of the run, used again by :meth:`refine`
-        self.parallel = parallel
+        #: the run it came from: :meth:`refine` uses its workers and executor again
+        self.run = run
 
     def refine(self, voxels: Voxels, levels: int, progress: Any = None,
                max_memory: Optional[int] = None) -> Voxels:
         """The patches voxelized on ``voxels.grid.finer(levels)`` (the same edges)."""
-        return _voxelize_on(self, voxels.grid.finer(levels), progress, dict(voxels.metadata),
-                            memory_budget(max_memory))
+        return _voxelize_on(self, voxels.grid.finer(levels),
+                            self.run.again(max_memory=max_memory, progress=progress),
+                            dict(voxels.metadata))
 
     def normals_at(self, points: np.ndarray) -> np.ndarray:
         """Unit normals at ``points`` of the nearest flat piece of the patches (for shading)."""
@@ -100,7 +97,7 @@ def voxelize_bezier(patches: Union[BezierPatch, Iterable[BezierPatch]],
     -------
     Voxels
     """
-    budget = memory_budget(max_memory)
+    run = Run.of(max_memory=max_memory, progress=progress, workers=workers, executor=executor)
     if isinstance(patches, BezierPatch):
         patches = [patches]
     patches = list(patches)
@@ -116,21 +113,14 @@ def voxelize_bezier(patches: Union[BezierPatch, Iterable[BezierPatch]],
         own = (tuple(nets.min(0).tolist()), tuple(nets.max(0).tolist()))
     grid = grid_of(own, bounds, resolution, voxel_size, "the patches")
     metadata = {"model": f"{len(patches)} Bezier patches", "flatness": flatness}
-    source = BezierSource(patches, flatness, (validate.workers(workers),
-                                              validate.executor(executor)))
-    return _voxelize_on(source, grid, progress, metadata, budget)
+    source = BezierSource(patches, flatness, run)
+    return _voxelize_on(source, grid, run, metadata)
 
 
-def _voxelize_on(source: BezierSource, grid: Grid, progress: Any, metadata: dict,
-                 budget: int) -> Voxels:
+def _voxelize_on(source: BezierSource, grid: Grid, run: Run, metadata: dict) -> Voxels:
     t0 = time.perf_counter()
     tri, dil = bezier_triangles(source.patches, source.flatness * np.asarray(grid.voxel_size))
-    workers, executor = source.parallel
-    workers = plan_workers(workers, executor, estimate_mesh_voxels(tri, grid))
-    refuse_over_budget(estimate_mesh_memory(tri, grid, False, workers), budget,
-                       f"voxelizing the patches at {grid.shape}")
-    codes = surface_codes(Triangles(tri, dil), grid, progress=progress, workers=workers,
-                          executor=executor)
+    codes = triangle_surface(Triangles(tri, dil), grid, run, "the patches")
     tree = Octree.from_codes(codes, grid.depth, {}, presorted=True)
     metadata = dict(metadata, seconds_total=time.perf_counter() - t0)
     return Voxels(grid, tree, {}, metadata, source=source)

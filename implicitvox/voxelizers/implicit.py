@@ -18,21 +18,21 @@ from typing import Any, Callable, Optional, Union
 import numpy as np
 
 from .. import batches
-from .. import validate
 from ..version import __version__
 from ..eval.function import Function
 from ..expr.shape import as_shape, exact_classifier, voxel_classifier
 from ..meshing.mesher import REFINE, mesh, mesh_grid
 from ..octree.morton import MAX_BITS
 from ..octree.grid import Grid, grid_of
-from ..octree.guard import MemoryGuard
+from ..octree.pilot import Estimate, estimate_surface
+from ..octree.run import Run
 from ..octree.store import Octree
-from ..octree.subdivide import RECHECK, subdivide
-from ..octree.surface import subdivide_voxels, surface_payload, unit_vectors, voxel_normals
+from ..octree.subdivide import RECHECK
+from ..octree.surface import (SurfaceOptions, subdivide_voxels, surface_payload, unit_vectors,
+                              voxel_normals)
 from ..octree.subtrees import parallel_bytes, subdivide_in_parallel
-from ..parallel import plan_workers
 from ..octree.voxels import Voxels
-from ..octree.budget import memory_budget, refuse_over_budget
+from .. import validate
 
 __all__ = ["voxelize", "estimate_memory", "bytes_per_voxel", "grid_of", "ImplicitSource",
            "voxel_normals"]
@@ -40,8 +40,6 @@ __all__ = ["voxelize", "estimate_memory", "bytes_per_voxel", "grid_of", "Implici
 #: bytes per surface voxel while collecting and building (coords, codes, sort, tree)
 _BYTES_PER_VOXEL = 48
 _BYTES_PER_NORMAL = 24
-_PILOT_DEPTH = 6
-_PILOT_BELOW = 2
 #: bytes of working interval arrays per box in a chunk (a few dozen float64 registers)
 _BYTES_PER_BOX = 512
 #: a run whose surface voxels are at least this share of a grid of at least
@@ -51,30 +49,12 @@ USELESS_MIN_CELLS = 4096
 
 
 def estimate_memory(func: Function, grid: Grid, normals: bool = False, prune: bool = True
-                    ) -> tuple[int, int]:
-    """Estimated surface voxels and peak bytes of a voxelization.
-
-    A pilot subdivision to depth :func:`pilot_depth_for` counts the AMBIGUOUS
-    octants there and extrapolates with Stolte's growth factor of 4 per level
-    (§4.1.3); the working set of the subdivision itself is bounded.
-    """
-    depth = grid.depth
-    pilot_depth = pilot_depth_for(depth)
-    pilot = grid.coarser(depth - pilot_depth)
-    # The pilot's voxels are unions of grid voxels; crop effects are ignored.
-    # No recheck: the pilot is cheaper and its count an upper estimate.
-    found = len(subdivide(func, pilot, recheck=0.0, prune=prune).codes)
-    cells = int(np.prod(grid.shape, dtype=np.float64))
-    voxels = min(found * 4 ** (depth - pilot_depth), cells)
-    return int(voxels), int(voxels * bytes_per_voxel(normals) + working_bytes(grid))
-
-
-def pilot_depth_for(depth: int) -> int:
-    """The depth of the pilot run of a grid of ``depth`` levels: :data:`_PILOT_DEPTH`
-    (64³), and at least :data:`_PILOT_BELOW` levels coarser than the grid (a
-    sixteenth of its voxels), so that the estimate costs little beside the run
-    even on small grids; the whole grid only when it has 2 levels or fewer."""
-    return max(min(depth, 2), min(_PILOT_DEPTH, depth - _PILOT_BELOW))
+                    ) -> tuple[Estimate, int]:
+    """The pilot's estimate of the surface voxels
+    (:func:`implicitvox.octree.pilot.estimate_surface`) and the peak bytes of a
+    serial voxelization: the kept voxels and the subdivision's working arrays."""
+    estimate = estimate_surface(func, grid, prune=prune)
+    return estimate, int(estimate.voxels * bytes_per_voxel(normals) + working_bytes(grid))
 
 
 def working_bytes(grid: Grid) -> int:
@@ -94,13 +74,12 @@ class ImplicitSource:
     """The shape and options a :class:`Voxels` came from (its
     :class:`~implicitvox.octree.voxels.VoxelSource`)."""
 
-    def __init__(self, shape: Any, func: Function, options: dict[str, Any],
-                 parallel: tuple[Optional[int], Any] = (1, None)):
+    def __init__(self, shape: Any, func: Function, options: SurfaceOptions, run: Run):
         self.shape = shape
         self.func = func
-        self.options = dict(options)
-        #: ``(workers, executor)`` of the run, used again by :meth:`refine`
-        self.parallel = parallel
+        self.options = options
+        #: the run it came from: :meth:`refine` uses its workers and executor again
+        self.run = run
 
     def refine(self, voxels: Voxels, levels: int, progress: Any = None,
                max_memory: Optional[int] = None) -> Voxels:
@@ -108,8 +87,8 @@ class ImplicitSource:
         old depth) on ``voxels.grid.finer(levels)``, under the memory budget."""
         grid = voxels.grid.finer(levels)
         coords = voxels.coords().astype(np.int32)
-        return _run(self, grid, progress, start=(voxels.grid.depth, coords),
-                    interior_before=voxels.interior, budget=memory_budget(max_memory))
+        return _run(self, grid, self.run.again(max_memory=max_memory, progress=progress),
+                    start=(voxels.grid.depth, coords), interior_before=voxels.interior)
 
     def to_mesh(self, voxels: Voxels, tolerance: Optional[float] = None, *,
                 refine: Optional[int] = None, progress: Any = None,
@@ -119,13 +98,13 @@ class ImplicitSource:
         levels = REFINE if refine is None else validate.int_in(refine, "refine", 0, 12)
         if tolerance is not None:
             return mesh(self.shape, tolerance, bounds=voxels.grid.bounds, refine=levels,
-                        progress=progress, max_memory=max_memory,
-                        prune=self.options["prune"])
+                        progress=progress, max_memory=max_memory, prune=self.options.prune)
         if voxels.grid.depth + levels > MAX_BITS:
             raise ValueError(f"to_mesh with refine={levels} on a depth-{voxels.grid.depth} "
                              f"grid needs more than the octree's {MAX_BITS} levels; lower refine")
-        return mesh_grid(self.shape, voxels.grid, refine=levels, progress=progress,
-                         budget=memory_budget(max_memory), prune=self.options["prune"])
+        return mesh_grid(self.shape, voxels.grid, Run.of(max_memory=max_memory,
+                                                         progress=progress),
+                         refine=levels, prune=self.options.prune)
 
     def normals_at(self, points: np.ndarray) -> np.ndarray:
         """Unit gradients of the shape's function at ``points`` (n, 3)."""
@@ -216,52 +195,40 @@ def voxelize(shape: Any, resolution: Union[int, tuple[int, int, int], None] = No
         When the estimate exceeds ``max_memory``.
     """
     shape = as_shape(shape)
-    budget = memory_budget(max_memory)
-    options = {"interior": validate.boolean(interior, "interior"),
-               "normals": validate.boolean(normals, "normals"),
-               "mean_value": validate.boolean(mean_value, "mean_value"),
-               "subvoxel": validate.int_in(subvoxel, "subvoxel", 0, 4),
-               "recheck": validate.number_in(recheck, "recheck", 0.0, 4.0),
-               "prune": validate.boolean(prune, "prune")}
+    run = Run.of(max_memory=max_memory, progress=progress, workers=workers, executor=executor)
+    options = SurfaceOptions.of(interior=interior, normals=normals, mean_value=mean_value,
+                                subvoxel=subvoxel, recheck=recheck, prune=prune)
     grid = grid_of(getattr(shape, "bounds", None), bounds, resolution, voxel_size)
-    if grid.depth + options["subvoxel"] > 21:
-        raise ValueError(f"resolution {grid.shape} with subvoxel={subvoxel} exceeds the octree's "
-                         "21 levels")
-    parallel = (validate.workers(workers), validate.executor(executor))
+    options.check_depth(grid)
     func = Function(shape.expr)
-    return _run(ImplicitSource(shape, func, options, parallel), grid, progress, start=None,
-                interior_before=None, budget=budget)
+    return _run(ImplicitSource(shape, func, options, run), grid, run, start=None,
+                interior_before=None)
 
 
-def _run(source: ImplicitSource, grid: Grid, progress, start, interior_before,
-         budget: int) -> Voxels:
+def _run(source: ImplicitSource, grid: Grid, run: Run, start, interior_before) -> Voxels:
     """Estimate, refuse over the budget, then subdivide under a guard of the same budget."""
     shape, func, options = source.shape, source.func, source.options
-    estimated_voxels, estimated_bytes = estimate_memory(func, grid, options["normals"],
-                                                        options["prune"])
-    workers, executor = source.parallel
-    workers = plan_workers(workers, executor, estimated_voxels)
-    per_voxel = bytes_per_voxel(options["normals"])
+    estimate, estimated_bytes = estimate_memory(func, grid, options.normals, options.prune)
+    workers = run.workers_for(estimate.voxels)
+    per_voxel = bytes_per_voxel(options.normals)
     if workers > 1:
-        estimated_bytes = parallel_bytes(estimated_voxels, per_voxel, working_bytes(grid),
+        estimated_bytes = parallel_bytes(estimate.voxels, per_voxel, working_bytes(grid),
                                          workers)
     what = f"voxelizing at {grid.shape}"
-    refuse_over_budget(estimated_bytes, budget, f"{what} (~{estimated_voxels:,} surface voxels"
-                       + (f", {workers} workers)" if workers > 1 else ")"))
-    guard = MemoryGuard(budget, what, per_voxel,
-                        estimated_voxels=estimated_voxels, working=working_bytes(grid))
+    run.refuse(estimated_bytes, f"{what} ({estimate.explained()}"
+               + (f"; {workers} workers)" if workers > 1 else ")"))
+    guard = run.guard(what, per_voxel, estimated=estimate.voxels, working=working_bytes(grid))
     t0 = time.perf_counter()
     split = None
-    if workers > 1 or executor is not None:
-        split = subdivide_in_parallel(shape, func, grid, options, workers=workers,
-                                      executor=executor, progress=progress, start=start,
-                                      budget=budget, per_voxel=per_voxel, guard=guard,
-                                      what=what, estimated=estimated_voxels)
+    if workers > 1 or run.executor is not None:
+        split = subdivide_in_parallel(shape, func, grid, options, run, workers=workers,
+                                      start=start, per_voxel=per_voxel, guard=guard,
+                                      what=what, estimated=estimate.voxels)
     if split is None:
         result = subdivide_voxels(func, grid, options,
                                   (exact_classifier(shape), voxel_classifier(shape)),
-                                  progress, start, guard)
-        payload = surface_payload(func, grid, result, options["normals"])
+                                  run.progress, start, guard)
+        payload = surface_payload(func, grid, result, options.normals)
         count = len(result.codes)
     else:
         result, count = split.result, split.count
@@ -277,7 +244,7 @@ def _run(source: ImplicitSource, grid: Grid, progress, start, interior_before,
         "seconds_total": time.perf_counter() - t0,
         "boxes_evaluated": result.evaluated,
         "tapes_built": result.tapes_built,
-        "estimated_voxels": estimated_voxels,
+        "estimated_voxels": estimate.voxels,
         "workers": workers if split is not None else 1,
         "implicitvox": __version__,
     }

@@ -30,15 +30,13 @@ from ..triangles.fill import BYTES_PER_VOXEL, interior_octants
 from ..triangles.inputs import as_triangles
 from ..triangles.pairs import surface_codes
 from ..triangles.tribox import Triangles
-from ..octree.grid import Grid
+from ..octree.grid import Grid, grid_of
+from ..octree.run import Run
 from ..octree.store import Octree
 from ..octree.voxels import Voxels
-from ..octree.grid import grid_of
-from ..octree.budget import memory_budget, refuse_over_budget
-from ..parallel import plan_workers
 
 __all__ = ["voxelize_mesh", "mesh_bounds", "MeshSource", "nearest_triangle_normals",
-           "estimate_mesh_voxels", "estimate_mesh_memory"]
+           "triangle_surface", "estimate_triangle_voxels", "estimate_triangle_memory"]
 
 #: bytes per surface voxel (codes, sort, octree) and per (node, triangle) pair
 _BYTES_PER_VOXEL = 40
@@ -47,19 +45,19 @@ _BYTES_PER_VOXEL = 40
 class MeshSource:
     """The triangles a :class:`Voxels` came from (so it can be refined)."""
 
-    def __init__(self, triangles: Triangles, name: str, interior: bool,
-                 parallel: tuple[Optional[int], Any] = (1, None)):
+    def __init__(self, triangles: Triangles, name: str, interior: bool, run: Run):
         self.triangles = triangles
         self.name = name
         self.interior = interior
-        #: ``(workers, executor)`` of the run, used again by :meth:`refine`
-        self.parallel = parallel
+        #: the run it came from: :meth:`refine` uses its workers and executor again
+        self.run = run
 
     def refine(self, voxels: Voxels, levels: int, progress: Any = None,
                max_memory: Optional[int] = None) -> Voxels:
         """The mesh voxelized on ``voxels.grid.finer(levels)`` (the same edges)."""
-        return _voxelize_on(self, voxels.grid.finer(levels), progress, dict(voxels.metadata),
-                            memory_budget(max_memory))
+        return _voxelize_on(self, voxels.grid.finer(levels),
+                            self.run.again(max_memory=max_memory, progress=progress),
+                            dict(voxels.metadata))
 
     def normals_at(self, points: np.ndarray) -> np.ndarray:
         """Unit normals ``(n, 3)`` of the triangles nearest to ``points`` (for shading)."""
@@ -149,27 +147,33 @@ def voxelize_mesh(mesh: Any, resolution: Union[int, tuple[int, int, int], None] 
     """
     vertices, faces = as_triangles(mesh)
     interior = validate.boolean(interior, "interior")
-    budget = memory_budget(max_memory)
+    run = Run.of(max_memory=max_memory, progress=progress, workers=workers, executor=executor)
     if not len(faces) and bounds is None:
         raise ValueError("the mesh has no triangles: pass bounds to get an empty voxelization")
     own = mesh_bounds(vertices, faces) if bounds is None else None
     grid = grid_of(own, bounds, resolution, voxel_size, "the mesh")
     name = os.fspath(mesh) if isinstance(mesh, (str, os.PathLike)) else type(mesh).__name__
-    source = MeshSource(Triangles(vertices[faces]), name, interior,
-                        (validate.workers(workers), validate.executor(executor)))
+    source = MeshSource(Triangles(vertices[faces]), name, interior, run)
     metadata = {"model": f"mesh {name}: {len(vertices)} vertices, {len(faces)} triangles"}
-    return _voxelize_on(source, grid, progress, metadata, budget)
+    return _voxelize_on(source, grid, run, metadata)
 
 
-def _voxelize_on(source: MeshSource, grid: Grid, progress: Any, metadata: dict,
-                 budget: int) -> Voxels:
-    workers, executor = source.parallel
-    workers = plan_workers(workers, executor, estimate_mesh_voxels(source.triangles.v, grid))
-    refuse_over_budget(estimate_mesh_memory(source.triangles.v, grid, source.interior, workers),
-                       budget, f"voxelizing the mesh at {grid.shape}")
+def triangle_surface(tris: Triangles, grid: Grid, run: Run, what: str,
+                     interior: bool = False) -> np.ndarray:
+    """Sorted Morton codes of the voxels the triangles meet
+    (:func:`implicitvox.triangles.pairs.surface_codes`), after the estimate is
+    refused over the ``run``'s budget (``interior``: counting the dense fill too),
+    on the workers the estimate plans."""
+    workers = run.workers_for(estimate_triangle_voxels(tris.v, grid))
+    run.refuse(estimate_triangle_memory(tris.v, grid, interior, workers),
+               f"voxelizing {what} at {grid.shape}")
+    return surface_codes(tris, grid, progress=run.progress, workers=workers,
+                         executor=run.executor)
+
+
+def _voxelize_on(source: MeshSource, grid: Grid, run: Run, metadata: dict) -> Voxels:
     t0 = time.perf_counter()
-    codes = surface_codes(source.triangles, grid, progress=progress, workers=workers,
-                          executor=executor)
+    codes = triangle_surface(source.triangles, grid, run, "the mesh", source.interior)
     t1 = time.perf_counter()
     interior = interior_octants(grid, codes, source.triangles.v) if source.interior else {}
     tree = Octree.from_codes(codes, grid.depth, {}, presorted=True)
@@ -178,7 +182,7 @@ def _voxelize_on(source: MeshSource, grid: Grid, progress: Any, metadata: dict,
     return Voxels(grid, tree, interior, metadata, source=source)
 
 
-def estimate_mesh_voxels(triangles: np.ndarray, grid: Grid) -> float:
+def estimate_triangle_voxels(triangles: np.ndarray, grid: Grid) -> float:
     """Surface voxels, from the triangles' area (a plane meets at most
     ``sqrt(3) * area / h**2`` voxels), plus a few per triangle."""
     e1 = triangles[:, 1] - triangles[:, 0]
@@ -189,12 +193,12 @@ def estimate_mesh_voxels(triangles: np.ndarray, grid: Grid) -> float:
     return min(1.8 * area + 8 * len(triangles), float(np.prod(grid.shape)))
 
 
-def estimate_mesh_memory(triangles: np.ndarray, grid: Grid, interior: bool,
+def estimate_triangle_memory(triangles: np.ndarray, grid: Grid, interior: bool,
                          workers: int = 1) -> int:
-    """Peak bytes: the surface voxels (:func:`estimate_mesh_voxels`), the dense
+    """Peak bytes: the surface voxels (:func:`estimate_triangle_voxels`), the dense
     fill when ``interior``, and with ``workers`` each worker's copy of the
     triangles and its share of the voxels."""
-    voxels = estimate_mesh_voxels(triangles, grid)
+    voxels = estimate_triangle_voxels(triangles, grid)
     need = voxels * _BYTES_PER_VOXEL + len(triangles) * 200
     if workers > 1:
         need += workers * (len(triangles) * 200 + 2 * voxels * _BYTES_PER_VOXEL / workers)

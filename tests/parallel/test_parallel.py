@@ -19,7 +19,9 @@ import csg
 import implicitvox as iv
 from implicitvox.expr import examples
 from implicitvox.parallel import Job, WorkerError, farm, plan_workers, split_evenly
+from implicitvox.octree.run import Run
 from implicitvox.octree.subtrees import subdivide_in_parallel
+from implicitvox.octree.surface import SurfaceOptions
 
 HERE = os.path.dirname(__file__)
 FIXTURES = os.path.join(HERE, "..", "openscad")
@@ -214,6 +216,68 @@ def test_ctrl_c_stops_the_master_and_every_worker(tmp_path):
         pytest.fail("worker processes outlived the interrupted run")
 
 
+def _alive(pid: int) -> bool:
+    """Whether a process runs (a zombie, dead but not yet reaped, does not)."""
+    try:
+        with open(f"/proc/{pid}/stat") as fh:
+            return fh.read().rsplit(")", 1)[1].split()[0] != "Z"
+    except OSError:
+        return False
+
+
+@pytest.mark.skipif(not hasattr(os, "fork") or not os.path.isdir("/proc"),
+                    reason="forks and reads /proc (Linux)")
+def test_a_forked_child_has_its_own_pool_and_its_workers_die_with_it(tmp_path):
+    """A child forked from a process that already has a pool starts its own (the
+    parent's is not its to use), and its workers exit with it when it leaves by
+    ``os._exit`` (no atexit: as a test runner's or multiprocessing's children do)."""
+    script = tmp_path / "fork.py"
+    script.write_text(textwrap.dedent("""
+        import os, sys, time
+        import implicitvox as iv
+        from implicitvox import x, y, z
+        import importlib
+        farm = importlib.import_module("implicitvox.parallel.farm")
+        sphere = x * x + y * y + z * z - 1
+        box = ((-1.2,) * 3, (1.2,) * 3)
+        first = iv.voxelize(sphere, 64, bounds=box, workers=2)     # the parent's pool
+        parents = [p.pid for p in farm._POOLS[2]._processes.values()]
+        read, write = os.pipe()
+        child = os.fork()
+        if child == 0:
+            again = iv.voxelize(sphere, 64, bounds=box, workers=2)
+            mine = [p.pid for p in farm._POOLS[2]._processes.values()]
+            os.write(write, (" ".join(map(str, mine)) + "\\n").encode())
+            os._exit(0 if again.count == first.count else 3)
+        os.close(write)
+        pids = [int(p) for p in os.fdopen(read).read().split()]
+        _, status = os.waitpid(child, 0)
+        print("child", os.waitstatus_to_exitcode(status), flush=True)
+        print("pids", *pids, flush=True)
+        print("shared", sorted(set(pids) & set(parents)), flush=True)
+        # the parent's pool is untouched and still runs
+        print("parent", iv.voxelize(sphere, 64, bounds=box, workers=2).count == first.count,
+              flush=True)
+    """))
+    run = subprocess.Popen([sys.executable, str(script)], stdout=subprocess.PIPE,
+                           stderr=subprocess.PIPE, text=True, start_new_session=True,
+                           env=dict(os.environ, IMPLICITVOX_WORKERS="2"))
+    try:
+        out, err = run.communicate(timeout=60)
+        lines = dict(line.split(" ", 1) for line in out.splitlines())
+        assert run.returncode == 0, err
+        assert lines["child"] == "0" and lines["shared"] == "[]" and lines["parent"] == "True"
+        pids = [int(p) for p in lines["pids"].split()]
+        assert len(pids) == 2
+        time.sleep(1.0)
+        assert not [pid for pid in pids if _alive(pid)], "the child's workers outlived it"
+    finally:
+        try:
+            os.killpg(run.pid, signal.SIGKILL)
+        except ProcessLookupError:
+            pass
+
+
 def test_the_default_uses_every_core_when_it_pays(monkeypatch):
     from implicitvox.parallel import plan
     monkeypatch.setattr(plan, "MIN_PARALLEL_WORK", 1)
@@ -257,15 +321,15 @@ def test_head_and_pieces_cover_the_serial_run():
     from implicitvox.octree.grid import Grid
     shape = examples.example("gear")
     grid = Grid.from_bounds(shape.bounds, 64)
-    options = {"interior": True, "normals": False, "mean_value": False, "subvoxel": 0,
-               "recheck": 0.25, "prune": True}
+    options = SurfaceOptions(interior=True)
     serial = iv.voxelize(shape, bounds=grid.bounds, voxel_size=grid.voxel_size[0],
                          interior=True, workers=1)
     with ThreadPoolExecutor(2) as pool:
-        joined = subdivide_in_parallel(shape, Function(shape.expr), grid, options, workers=3,
-                                       executor=pool, budget=1 << 30, per_voxel=48)
-        codes = subdivide_in_parallel(shape, Function(shape.expr), grid, options, workers=3,
-                                      executor=pool, budget=1 << 30, per_voxel=48, tapes=True)
+        run = Run.of(max_memory=1 << 30, executor=pool)
+        joined = subdivide_in_parallel(shape, Function(shape.expr), grid, options, run,
+                                       workers=3, per_voxel=48)
+        codes = subdivide_in_parallel(shape, Function(shape.expr), grid, options, run,
+                                      workers=3, per_voxel=48, tapes=True)
     assert joined.count == serial.count == sum(n for n, _ in codes.result.tapes)
     assert np.array_equal(joined.tree.coords(), serial.coords())
     assert all(np.array_equal(a, b) for a, b in zip(joined.tree.first, serial.octree.first))

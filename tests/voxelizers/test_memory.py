@@ -11,6 +11,7 @@ import pytest
 import implicitvox as ivx
 from implicitvox import sin, x, y, z
 from implicitvox.eval.function import Function
+from implicitvox.octree import pilot
 from implicitvox.octree.grid import Grid
 from implicitvox.voxelizers.implicit import estimate_memory
 
@@ -19,8 +20,25 @@ CUBE = ((-1.0,) * 3, (1.0,) * 3)
 WIGGLY = sin(100 * x) * sin(100 * y) * sin(100 * z)
 
 
-def test_a_run_that_beats_its_estimate_stops_at_the_budget():
-    voxels, estimated = estimate_memory(Function(WIGGLY), Grid.from_bounds(CUBE, 128))
+def test_the_pilot_sees_a_surface_that_fills_space():
+    """The pilot measures the growth per level: x8 here, not Stolte's x4."""
+    estimate, _ = estimate_memory(Function(WIGGLY), Grid.from_bounds(CUBE, 128))
+    assert estimate.growth == 8.0 and estimate.pilot_depth == 5
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", UserWarning)
+        vox = ivx.voxelize(WIGGLY, 128, bounds=CUBE, workers=1)
+    assert vox.count / 2 <= estimate.voxels <= 2 * vox.count
+    # the refusal says how it was estimated
+    with pytest.raises(MemoryError, match=r"estimated from 32,768 at a 32³ pilot growing "
+                                          r"8\.0× per level"):
+        ivx.voxelize(WIGGLY, 128, bounds=CUBE, max_memory=1 << 20, workers=1)
+
+
+def test_a_run_that_beats_its_estimate_stops_at_the_budget(monkeypatch):
+    # a pilot that assumed Stolte's x4 whatever it saw (as before it measured)
+    monkeypatch.setattr(pilot, "MOST_GROWTH", pilot.LEAST_GROWTH)
+    estimate, estimated = estimate_memory(Function(WIGGLY), Grid.from_bounds(CUBE, 128))
+    voxels = estimate.voxels
     # the pilot (32³) finds every cell ambiguous, and extrapolates x4 per level
     assert voxels == 32 ** 3 * 4 ** 2
     with warnings.catch_warnings():
