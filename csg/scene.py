@@ -72,6 +72,11 @@ NODE_TYPES = frozenset({
     "expression"})
 
 
+#: the longest string taken as a file name (Linux's PATH_MAX); a longer one that is not
+#: JSON is refused without echoing it
+MAX_PATH_CHARS = 4096
+
+
 class SceneError(ValueError):
     """A scene that cannot be read, with the JSON path of the problem."""
 
@@ -90,10 +95,19 @@ def to_json(solid: Solid, indent: Any = None) -> str:
 # -- reading -------------------------------------------------------------------------------
 def load_json(text_or_path: Any) -> Solid:
     """Read a JSON scene (text, or a path to a ``.json`` file)."""
+    import os
     text = text_or_path
+    if isinstance(text, bytes):
+        raise SceneError("load_json takes JSON text (a str) or a path, got bytes: decode them")
+    if not isinstance(text, (str, os.PathLike)):
+        raise SceneError(f"load_json takes JSON text or a path to a .json file, got "
+                         f"{type(text).__name__} {text!r:.60}")
     if not (isinstance(text, str) and text.lstrip()[:1] in ("{", "[")):
-        import os
         path = os.fspath(text_or_path)
+        if len(path) > MAX_PATH_CHARS or "\0" in path:
+            raise SceneError(f"load_json: {path[:60]!r}... ({len(path):,} characters) is "
+                             "neither JSON text (it does not start with '{' or '[') nor a "
+                             "file name")
         if not os.path.isfile(path):
             raise FileNotFoundError(f"no such scene file: {path}")
         if os.path.getsize(path) > LIMITS["text_bytes"]:

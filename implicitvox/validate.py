@@ -24,13 +24,14 @@ from __future__ import annotations
 
 import math
 import os
-from typing import Any, Optional
+from typing import Any, Callable, Optional
 
 import numpy as np
 
 __all__ = ["integer", "positive_int", "int_in", "number", "positive_number", "number_in",
            "boolean", "choice", "bounds", "resolution", "voxel_size", "points",
-           "writable_path", "max_memory", "workers", "executor", "MAX_WORKERS"]
+           "writable_path", "max_memory", "workers", "executor", "progress", "MAX_WORKERS",
+           "MIN_EXTENT"]
 
 _INTS = (int, np.integer)
 _NUMBERS = (int, float, np.integer, np.floating)
@@ -109,6 +110,10 @@ def choice(value: Any, name: str, options: tuple) -> Any:
     return value
 
 
+#: the least extent bounds may have on an axis: voxels of 2**-21 of it are normal floats
+MIN_EXTENT = float(np.finfo(np.float64).tiny) * 2.0 ** 21
+
+
 def bounds(value: Any, name: str = "bounds") -> tuple[tuple[float, ...], tuple[float, ...]]:
     """``((x0, y0, z0), (x1, y1, z1))``, finite, with positive extent on every axis."""
     try:
@@ -124,6 +129,15 @@ def bounds(value: Any, name: str = "bounds") -> tuple[tuple[float, ...], tuple[f
         if not b[1, a] > b[0, a]:
             raise ValueError(f"{name} have zero or negative extent on axis {'xyz'[a]}: "
                              f"{b[0, a]!r} .. {b[1, a]!r}")
+        with np.errstate(over="ignore"):
+            extent = float(b[1, a] - b[0, a])
+        if not np.isfinite(extent):
+            raise ValueError(f"{name} have an extent on axis {'xyz'[a]} beyond the largest "
+                             f"float: {float(b[0, a])!r} .. {float(b[1, a])!r}")
+        if extent < MIN_EXTENT:
+            raise ValueError(f"{name} have an extent of {extent!r} on axis {'xyz'[a]}, below "
+                             f"{MIN_EXTENT!r} (implicitvox.validate.MIN_EXTENT): its voxels "
+                             "would be smaller than the smallest normal float")
     return tuple(b[0].tolist()), tuple(b[1].tolist())
 
 
@@ -164,6 +178,14 @@ def points(value: Any, name: str = "points", *, finite: bool = True) -> np.ndarr
         raise ValueError(f"{name} holds {'a non-finite value' if finite else 'NaN'} "
                          f"(row {i})")
     return p
+
+
+def progress(value: Any, name: str = "progress") -> Optional[Callable[[float], Any]]:
+    """None or a callable taking the fraction done (a float from 0 to 1)."""
+    if value is None or callable(value):
+        return value
+    raise ValueError(f"{name} must be None or a callable taking the fraction done, "
+                     f"got {_shown(value)}")
 
 
 def writable_path(path: Any, name: str = "path") -> str:

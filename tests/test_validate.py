@@ -4,7 +4,11 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+import implicitvox as ivx
 from implicitvox import validate as v
+from implicitvox import x, y, z
+
+SPHERE = x * x + y * y + z * z - 1
 
 
 @pytest.mark.parametrize("check, value, message", [
@@ -34,3 +38,27 @@ def test_good_values_come_back_canonical():
     assert v.max_memory(1.5e9) == 1_500_000_000 and v.max_memory(None) is None
     assert v.points([1, 2, 3]).shape == (1, 3)
     assert v.points([[0, -np.inf, 0]], finite=False).shape == (1, 3)
+
+
+@pytest.mark.parametrize("call, message", [
+    # bounds too small for a normal voxel size, or spanning more than a float holds
+    (lambda: ivx.voxelize(SPHERE, 8, bounds=((0, 0, 0), (5e-324,) * 3)),
+     r"extent of 5e-324 on axis x, below .*MIN_EXTENT"),
+    (lambda: ivx.voxelize(SPHERE, 8, bounds=((-1e308,) * 3, (1e308,) * 3)),
+     "extent on axis x beyond the largest float"),
+    (lambda: ivx.voxelize(SPHERE, voxel_size=5e-324, bounds=((0,) * 3, (1,) * 3)),
+     "voxel_size 5e-324 gives inf voxels on axis x"),
+    (lambda: ivx.voxelize(SPHERE, 8, bounds=((-1,) * 3, (1,) * 3), progress="notcallable"),
+     "progress must be None or a callable"),
+    (lambda: ivx.mesh(SPHERE, 0.5, bounds=((-1,) * 3, (1,) * 3), progress=3),
+     "progress must be None or a callable"),
+    (lambda: ivx.repeat(SPHERE, spacing=(1.5, None, None), count=1.5),
+     "count on x .or None. must be a positive int, got float 1.5"),
+    (lambda: ivx.repeat_polar(SPHERE, 1.5), "must be a positive int, got float 1.5"),
+])
+def test_hostile_arguments_name_the_parameter(call, message):
+    """No deep traceback from numpy or math: a ValueError raised by the checks."""
+    with pytest.raises(ValueError, match=message) as info:
+        call()
+    assert info.traceback[-1].path.name == "validate.py" or \
+        "octree/grid.py" in str(info.traceback[-1].path)

@@ -54,7 +54,7 @@ def _spacing_and_count(spacing: Any, count: Any) -> tuple[tuple, tuple]:
             out.append(None)
             continue
         out.append(validate.positive_number(s, f"spacing on {a} (or None)"))
-    if count is None or isinstance(count, (int, np.integer)):
+    if not isinstance(count, (tuple, list, np.ndarray)):
         counts = (count,) * 3
     else:
         counts = tuple(count)

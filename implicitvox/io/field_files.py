@@ -23,7 +23,7 @@ from .. import validate
 from ..fields.bricks import BRICK, MAX_BAND
 from ..fields.field import NORMS, DistanceField
 from ..octree.grid import MAX_RESOLUTION, Grid
-from .files import NPZ_LIMIT
+from .files import check_unpacked
 
 __all__ = ["save_field", "load_field", "FIELD_FORMATS"]
 
@@ -73,9 +73,7 @@ def load_field(path: str) -> DistanceField:
         for name in data.files:
             header = data.zip.getinfo(name + ".npy")
             declared += header.file_size
-        if declared > NPZ_LIMIT:
-            raise ValueError(f"{path!r} unpacks to {declared:,} bytes, over the limit of "
-                             f"{NPZ_LIMIT:,} (implicitvox.io.files.NPZ_LIMIT)")
+        check_unpacked(path, declared)
         need = ("format", "origin", "voxel_size", "shape", "norm", "band", "kind", "keys",
                 "values", "errors", "active", "signed")
         for name in need:

@@ -23,11 +23,13 @@ import numpy as np
 
 from .. import validate
 from ..triangles.isolated import run_isolated
+from ..octree.budget import available_memory, size_text
 from ..octree.grid import MAX_RESOLUTION, Grid
 from ..octree.store import Octree
 from ..octree.voxels import DEFAULT_DENSE_LIMIT, Voxels
 
-__all__ = ["save", "load", "save_mesh", "FORMATS", "MESH_FORMATS", "NPZ_LIMIT", "BINVOX_LIMIT"]
+__all__ = ["save", "load", "save_mesh", "check_unpacked", "FORMATS", "MESH_FORMATS",
+           "NPZ_LIMIT", "BINVOX_LIMIT"]
 
 FORMATS = (".npz", ".vti", ".binvox")
 #: triangle mesh files :func:`save_mesh` writes (through PyVista's VTK writers)
@@ -38,6 +40,19 @@ NPZ_LIMIT = 16 << 30
 #: voxels a .binvox may declare at most (the format is dense: one byte each in memory)
 BINVOX_LIMIT = 1 << 31
 _BINVOX_HEADER_LINES, _BINVOX_HEADER_LINE = 64, 4096
+
+
+def check_unpacked(path: str, unpacked: int) -> None:
+    """Refuse an ``.npz`` whose members unpack to more than :data:`NPZ_LIMIT`
+    (``ValueError``) or than this process may still allocate (``MemoryError``,
+    :func:`implicitvox.octree.budget.available_memory`), before anything is read."""
+    if unpacked > NPZ_LIMIT:
+        raise ValueError(f"{path!r} unpacks to {size_text(unpacked)}, over the limit "
+                         f"of {size_text(NPZ_LIMIT)} (implicitvox.io.files.NPZ_LIMIT)")
+    room = available_memory()
+    if unpacked > room:
+        raise MemoryError(f"{path!r} unpacks to {size_text(unpacked)}, more than the "
+                          f"{size_text(room)} this process may still use")
 
 
 def _suffix(path: str) -> str:
@@ -133,10 +148,7 @@ def _load_npz(path: str) -> Voxels:
     if not hasattr(data, "files"):
         raise ValueError(f"{path!r} is not an implicitvox .npz file (one array, not an archive)")
     with data:
-        unpacked = sum(info.file_size for info in data.zip.infolist())
-        if unpacked > NPZ_LIMIT:
-            raise ValueError(f"{path!r} unpacks to {unpacked / 2**30:.2f} GiB, over the limit "
-                             f"of {NPZ_LIMIT / 2**30:.0f} GiB (implicitvox.io.files.NPZ_LIMIT)")
+        check_unpacked(path, sum(info.file_size for info in data.zip.infolist()))
         try:
             version = data["format"] if "format" in data else None
         except ValueError as err:

@@ -45,10 +45,12 @@ MAX_RESOLUTION = 1 << MAX_BITS
 def _whole_voxels(extent: float, pitch: float, axis: str) -> int:
     """Voxels of ``pitch`` covering ``extent`` (an extent within rounding of a
     whole number of voxels is not given one more)."""
-    n = max(1, math.ceil(extent / pitch * (1.0 - 1e-12)))
+    with np.errstate(over="ignore", divide="ignore"):
+        ratio = np.float64(extent) / np.float64(pitch) * (1.0 - 1e-12)
+    n = max(1, math.ceil(ratio)) if ratio <= MAX_RESOLUTION else MAX_RESOLUTION + 1
     if n > MAX_RESOLUTION:
-        raise ValueError(f"voxel_size {pitch!r} gives {n} voxels on axis {axis}, over the "
-                         f"octree's {MAX_RESOLUTION}")
+        raise ValueError(f"voxel_size {pitch!r} gives {ratio:.4g} voxels on axis {axis}, "
+                         f"over the octree's {MAX_RESOLUTION}")
     return n
 
 

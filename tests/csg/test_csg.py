@@ -201,6 +201,18 @@ def test_hostile_scenes(scene, match):
         load_json(scene)
 
 
+def test_what_is_neither_json_nor_a_path_is_refused_without_echoing_it():
+    with pytest.raises(SceneError, match="got NoneType None"):
+        load_json(None)
+    with pytest.raises(SceneError, match="got bytes"):
+        load_json(b'{"implicitvox_scene": 1}')
+    with pytest.raises(SceneError, match=r"\(300,000,000 characters\) is neither JSON") as info:
+        load_json("x" * 300_000_000)
+    assert len(str(info.value)) < 300
+    with pytest.raises(FileNotFoundError, match="no such scene file"):
+        load_json("no/such/scene.json")
+
+
 def test_linf_distance_of_transformed_primitives():
     rng = np.random.default_rng(9)
     p = rng.normal(size=(2000, 3)) * 2

@@ -254,3 +254,12 @@ def test_degenerate_facets_are_refused_with_their_location(text):
     """Found by the long fuzz run: Qhull's error escaped as a QhullError."""
     with pytest.raises(OpenSCADError, match="1:1: .*: the points span no volume"):
         read_openscad(text, facets="openscad")
+
+
+def test_an_npz_larger_than_the_memory_left_says_which_file_and_how_much(saved, tmp_path,
+                                                                            monkeypatch):
+    monkeypatch.setattr(files, "available_memory", lambda: 100)
+    path = _npz(tmp_path, dict(saved[1]))
+    with pytest.raises(MemoryError, match=r"bad\.npz. unpacks to .* MiB, more than the 0\.0 "
+                                          r"MiB this process may still use"):
+        ivx.load(path)
