@@ -31,19 +31,21 @@ True
 from __future__ import annotations
 
 import math
-from typing import Optional
+from typing import Any, Optional
 
 import numpy as np
 
 from .planar import Circle, Polygon, Rectangle, pieces_polygon
 from .solid import Difference, Intersection, Solid, Transformed, Union
 
-__all__ = ["region_paths", "region_pieces", "simple_pieces", "offset", "to_polygon", "clip", "to_clipper",
-           "CLIPPER_SCALE",
+__all__ = ["region_paths", "region_pieces", "simple_pieces", "offset", "to_polygon", "clip",
+           "to_clipper", "check_range", "OutOfRange", "CLIPPER_SCALE", "CLIPPER_RANGE",
            "MITER_LIMIT", "NotFlat"]
 
 #: OpenSCAD 2021.01's ``ClipperUtils::CLIPPER_SCALE``: points are times this, truncated
 CLIPPER_SCALE = float(1 << 16)
+#: Clipper's largest coordinate (its ``hiRange``, 2^62 - 1): a larger one throws from C++
+CLIPPER_RANGE = float((1 << 62) - 1)
 #: OpenSCAD's ``offset`` miter limit (``delta`` keeps every corner sharp)
 MITER_LIMIT = 1_000_000.0
 _JOINS = {"round": "JT_ROUND", "miter": "JT_MITER", "square": "JT_SQUARE"}
@@ -53,10 +55,38 @@ class NotFlat(ValueError):
     """A 2D tree with a leaf that has no outline (a true circle: facet it first)."""
 
 
-def to_clipper(points: np.ndarray) -> list:
+class OutOfRange(ValueError):
+    """A 2D coordinate beyond what Clipper can hold (:data:`CLIPPER_RANGE`)."""
+
+
+def to_clipper(points: np.ndarray, *, rounding: Any = np.trunc) -> list:
     """Points as Clipper's integers: times :data:`CLIPPER_SCALE`, truncated toward zero
-    (C++'s conversion of a double to ``IntPoint``)."""
-    return np.trunc(points * CLIPPER_SCALE).astype(np.int64).tolist()
+    (C++'s conversion of a double to ``IntPoint``), or rounded by ``rounding``.
+
+    Raises
+    ------
+    OutOfRange
+        A coordinate beyond :data:`CLIPPER_RANGE` once scaled (Clipper would throw
+        from C++, which ends the process), or not finite.
+    """
+    with np.errstate(over="ignore", invalid="ignore"):
+        scaled = rounding(np.asarray(points, dtype=np.float64) * CLIPPER_SCALE)
+    check_range(scaled)
+    return scaled.astype(np.int64).tolist()
+
+
+def check_range(scaled: Any, reach: float = 0.0) -> None:
+    """``OutOfRange`` unless every scaled coordinate, grown by ``reach`` (scaled too:
+    an offset's distance), lies within Clipper's :data:`CLIPPER_RANGE`."""
+    scaled = np.asarray(scaled, dtype=np.float64)
+    largest = float(np.max(np.abs(scaled), initial=0.0)) if scaled.size else 0.0
+    if not (math.isfinite(largest) and math.isfinite(reach)) or \
+            largest + abs(reach) > CLIPPER_RANGE:
+        worst = (largest + abs(reach)) / CLIPPER_SCALE
+        raise OutOfRange(f"a 2D coordinate of magnitude {worst:.4g} is beyond the "
+                         f"±{CLIPPER_RANGE / CLIPPER_SCALE:.4g} that Clipper (OpenSCAD's 2D "
+                         "geometry library) can hold at OpenSCAD's scale of 2^16 per unit "
+                         "(csg.clipper2d.CLIPPER_RANGE)")
 
 
 def clip(subjects: list, clips: list, operation: str, fill: str = "PFT_NONZERO") -> list:
@@ -177,8 +207,7 @@ def simple_pieces(pieces: list) -> list[tuple[np.ndarray, list[np.ndarray]]]:
         (split if any(touching(r) for r in rings) else plain).append((rings[0], rings[1:]))
     if not split:
         return plain
-    paths = [np.round(r * CLIPPER_SCALE).astype(np.int64).tolist()
-             for outer, holes in split for r in (outer, *holes)]
+    paths = [to_clipper(r, rounding=np.round) for outer, holes in split for r in (outer, *holes)]
     return plain + _tree_pieces(paths)
 
 
@@ -210,6 +239,7 @@ def offset(solid: Solid, delta: float, join: str = "round", fragments: Optional[
     n = fragments or 3
     arc_tolerance = abs(delta) * (1 - math.cos(math.radians(180.0 / n)))
     united = clip(region_paths(solid), [], "CT_UNION")
+    check_range([c for path in united for point in path for c in point], delta * CLIPPER_SCALE)
     co = pyclipper.PyclipperOffset(MITER_LIMIT, arc_tolerance * CLIPPER_SCALE)
     if united:
         co.AddPaths(united, getattr(pyclipper, _JOINS[join]), pyclipper.ET_CLOSEDPOLYGON)

@@ -141,6 +141,44 @@ def test_mutated_files_load_or_are_refused_in_time(tmp_path):
     assert sum(outcomes.values()) == INPUTS and "ok" in outcomes
 
 
+#: hostile-number mutants of the OpenSCAD fixtures read and voxelized in the suite
+#: (``tests/benchmarks/bench_fuzz_csg.py`` runs thousands)
+CSG_MUTANTS = int(os.environ.get("IMPLICITVOX_FUZZ_CSG", "150"))
+
+
+def run_csg_mutants(folder: Path, count: int, seed: int) -> tuple[dict, list[str]]:
+    """Read and voxelize ``count`` hostile-number mutants (:mod:`tests.support.hostile_csg`)
+    in a watched worker: the outcomes counted, and the failures (a crash, a hang, an
+    undocumented error) described."""
+    from tests.support.hostile_csg import mutants
+    worker = _Worker()
+    failures, outcomes = [], {}
+    try:
+        for k, (label, text) in enumerate(mutants(count, seed)):
+            path = folder / f"mutant{k % 16}.csg"
+            path.write_text(text)
+            t0 = time.perf_counter()
+            answer = worker.ask(f"voxelize {path}")
+            if answer.startswith(("ok", "refused")) and time.perf_counter() - t0 <= TIME_LIMIT:
+                outcomes[answer] = outcomes.get(answer, 0) + 1
+                continue
+            failures.append(f"{label}: {answer} ({time.perf_counter() - t0:.1f} s)")
+            if answer.startswith(("hang", "crash")):
+                worker = _Worker()
+    finally:
+        worker.close()
+    return outcomes, failures
+
+
+def test_hostile_numbers_in_csg_files_are_read_and_voxelized_or_refused(tmp_path):
+    """Every numeric field may be huge, tiny, subnormal, infinite or NaN: no crash (a
+    signal from Clipper's C++), no hang, no error but the documented ones."""
+    outcomes, failures = run_csg_mutants(tmp_path, CSG_MUTANTS, 20261206)
+    print(f"{CSG_MUTANTS} hostile-number mutants: {outcomes}")
+    assert not failures, "\n".join(failures[:10])
+    assert sum(outcomes.values()) == CSG_MUTANTS and "ok" in outcomes
+
+
 JSON_VALUES = st.recursive(
     st.none() | st.booleans() | st.integers(-10**30, 10**30) | st.floats(allow_nan=False)
     | st.text(max_size=12) | st.sampled_from(["sphere", "box", "union", "transform", "expression",

@@ -1,6 +1,8 @@
 """The fuzz suite's reader process: reads the files named on stdin, one line each.
 
-For every path it answers one line: ``ok``, ``refused <Type>`` (a documented
+A line ``voxelize <path>`` reads an OpenSCAD ``.csg`` in both facet modes (its
+imports from the fixtures' folder) and voxelizes each at 16³ on one worker
+under a 256 MiB budget. For every path it answers one line: ``ok``, ``refused <Type>`` (a documented
 error: ``ValueError`` and its subclasses, ``FileNotFoundError``,
 ``MemoryError``) or ``bad <Type>: <message>`` (anything else). The parent
 process watches it with a time limit per input, so a hang or a crash (a
@@ -36,11 +38,21 @@ def read(path: str) -> None:
         as_triangles(path)
 
 
+def voxelize(path: str) -> None:
+    from tests.support.hostile_csg import FIXTURES
+    for facets in ("openscad", "true"):
+        solid = read_openscad(path, facets=facets, base=str(FIXTURES))
+        solid.voxelize(16, workers=1, max_memory=1 << 28)
+
+
 def main() -> None:
     for line in sys.stdin:
         path = line.rstrip("\n")
         try:
-            read(path)
+            if path.startswith("voxelize "):
+                voxelize(path[len("voxelize "):])
+            else:
+                read(path)
             answer = "ok"
         except DOCUMENTED as err:
             answer = f"refused {type(err).__name__}"
