@@ -11,7 +11,7 @@ import itertools
 import mpmath
 import numpy as np
 import pytest
-from hypothesis import HealthCheck, assume, given, settings
+from hypothesis import HealthCheck, assume, example, given, settings
 from hypothesis import strategies as st
 
 import implicitvox as ivx
@@ -19,7 +19,7 @@ from implicitvox.eval.opcodes import OPCODES
 from implicitvox.eval.reference import apply_reference
 from implicitvox.eval.interval import apply_op
 from implicitvox.eval.point import apply_point
-from tests.support.reference import DPS, contains, iv_interval, mp_value
+from tests.support.reference import DPS, Unbounded, contains, iv_interval, mp_value
 from tests.support.strategies import (BINARY, box3, elements_for, expression, interval, param_for,
                               samples)
 
@@ -155,6 +155,7 @@ IV_BINARY = ("add", "sub", "mul", "div", "min", "max")
 
 @settings(max_examples=200, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(expr=expression(5, IV_UNARY, IV_BINARY, powers=False), box=box3(st.floats(-2.0, 2.0)))
+@example(expr=ivx.sin(ivx.x * (ivx.x / ivx.x)), box=([0.0] * 3, [0.0] * 3))
 def test_nested_expressions_hold_mpmath_iv_interval(expr, box):
     """Our enclosure contains mpmath's ``iv`` natural interval extension.
 
@@ -169,11 +170,14 @@ def test_nested_expressions_hold_mpmath_iv_interval(expr, box):
         ref = iv_interval(expr, lo, hi)
     except OverflowError:  # mpmath's iv.exp of an enormous interval; nothing to compare
         assume(False)
-    # Where iv went unbounded (a division by an interval holding 0) the
-    # conventions differ: iv keeps 0 * [-inf, inf] = [-inf, inf], ours reads
-    # the endpoints as reals and gives 0. Containment is then checked by the
-    # exact-value test above, not here.
-    assume(mpmath.isfinite(ref.a) and mpmath.isfinite(ref.b))
+    except Unbounded:
+        # Where iv went unbounded (a division by an interval holding 0) the
+        # conventions differ: iv keeps 0 * [-inf, inf] = [-inf, inf], ours reads
+        # the endpoints as reals and gives 0, and a sin or cos after it hides the
+        # difference in a finite result (sin(x * (x / x)) over x = [0, 0]: iv's
+        # [-1, 1], ours 0, where the function is undefined). Containment is then
+        # checked by the exact-value test above, not here.
+        assume(False)
     with mpmath.workdps(40):
         a, b = mpmath.mpf(ref.a), mpmath.mpf(ref.b)
         slack_a = mpmath.mpf(10) ** -30 * (1 + abs(a)) if mpmath.isfinite(a) else 0

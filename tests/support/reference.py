@@ -53,8 +53,16 @@ IV_OPS = {
 }
 
 
+class Unbounded(ArithmeticError):
+    """An intermediate of ``iv_interval`` was unbounded (a division by an interval
+    holding 0): mpmath's conventions (``0 * [-inf, inf] = [-inf, inf]``) and ours
+    (``0``) differ from there on, even where a bounded function (``sin``) follows."""
+
+
 def iv_interval(expr: Expr, lo, hi, dps: int = 40):
-    """mpmath ``iv`` natural interval extension of ``expr`` over a box (ops in IV_OPS)."""
+    """mpmath ``iv`` natural interval extension of ``expr`` over a box (ops in IV_OPS).
+
+    Raises :class:`Unbounded` when an intermediate interval is not finite."""
     iv.dps = dps
     vals = {}
     box = {n: iv.mpf([float(a), float(b)]) for n, a, b in zip("xyz", lo, hi)}
@@ -67,5 +75,7 @@ def iv_interval(expr: Expr, lo, hi, dps: int = 40):
             v = vals[id(node.args[0])] ** 2  # the tape rewrites a * a as square(a)
         else:
             v = IV_OPS[node.op]([vals[id(a)] for a in node.args], node.param)
+        if not (mpmath.isfinite(v.a) and mpmath.isfinite(v.b)):
+            raise Unbounded(f"{node.op} is unbounded over the box")
         vals[id(node)] = v
     return vals[id(expr)]
