@@ -25,7 +25,7 @@ from implicitvox import Expr, validate, linf, x, y, z
 from implicitvox.triangles.inputs import as_triangles
 from implicitvox.octree.morton import CORNERS
 
-from .classify import MeshClassifier, similarity_scale
+from .tree_classifier import MeshClassifier, similarity_scale
 from .solid import Bounds, Solid, box_bound, vector
 
 __all__ = ["Sphere", "Box", "Cylinder", "Torus", "Ellipsoid", "HalfSpace", "ConvexPolyhedron",
@@ -368,7 +368,7 @@ class ConvexPolyhedron(Solid):
 class Polyhedron(Solid):
     """Any closed triangle mesh (``vertices``, ``faces``, or a mesh file / PyVista mesh).
 
-    Its geometry lives in an exact box classification (:mod:`csg.classify`:
+    Its geometry lives in an exact box classification (:mod:`csg.tree_classifier`:
     the exact box-triangle test of :mod:`implicitvox.triangles.tribox`, and the
     winding number for boxes off the surface). Its expression is only a
     bound - positive outside the bounding box, zero inside - which

@@ -13,7 +13,7 @@ over a box near concave corners; its box test is exact:
   rectangle lies inside the region and its span reaches past a cap; a box off
   every edge is inside or outside the region by the crossing number at one of
   its corners (exact too);
-* placed otherwise, by its mesh (:class:`csg.classify.MeshClassifier`).
+* placed otherwise, by its mesh (:class:`csg.tree_classifier.MeshClassifier`).
 
 The outlines are taken to world space as the mesh's vertices would be (one
 rounding per coordinate), so both tests see the same prism.
@@ -41,7 +41,7 @@ from implicitvox.triangles.predicates import det2_sign
 from implicitvox.triangles.ranges import buckets, expand, expand_boxes, gather
 from implicitvox.triangles.pairs import sorted_unique
 
-from .classify import MeshClassifier
+from .tree_classifier import MeshClassifier
 from .clipper2d import simple_pieces
 from .facets import extrusion_mesh_outlines
 from .planar import LinearExtrude, pieces_polygon
@@ -86,7 +86,7 @@ class PrismClassifier:
 
     Edges are bucketed in a uniform grid over the region's rectangle (for the
     boxes' rectangles) and in its rows (for the crossing number), as
-    :class:`csg.classify.MeshClassifier` buckets triangles.
+    :class:`csg.tree_classifier.MeshClassifier` buckets triangles.
     """
 
     def __init__(self, rings: list[np.ndarray], axes: tuple[int, int, int], zlo: float,

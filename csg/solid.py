@@ -9,7 +9,7 @@ invertible affine 4 x 4 matrix). A transformed solid is its child's function
 at the pre-image of each point, so non-uniform scales and shears are exact.
 
 Solids with a :class:`~csg.primitives.Polyhedron` leaf also have an exact box
-classification (:attr:`Solid.classify_boxes`, see :mod:`csg.classify`), which
+classification (:attr:`Solid.classify_boxes`, see :mod:`csg.tree_classifier`), which
 the voxelizer uses on boxes the intervals leave ambiguous.
 
 Examples
@@ -34,7 +34,7 @@ import numpy as np
 import implicitvox as iv
 from implicitvox import Expr, validate, x, y, z
 
-from .classify import exact_classifier, plan, world_primitive
+from .tree_classifier import exact_classifier, plan, world_primitive
 
 __all__ = ["Solid", "Union", "Intersection", "Difference", "Complement", "Transformed",
            "ExprSolid", "Bounds", "rotation_matrix", "vector", "box_bound", "SCENE_FORMAT"]
@@ -61,7 +61,7 @@ class Solid:
 
     #: 3 for solids; 2 for planar regions (infinite prisms along z, for extrusions)
     dim = 3
-    #: what the exact classifier (:mod:`csg.classify`) reads of a node: its
+    #: what the exact classifier (:mod:`csg.tree_classifier`) reads of a node: its
     #: operation ("union", "intersection", "difference", "complement",
     #: "transform"; None for leaves and other nodes), whether it is a leaf with
     #: an exact test, and whether it has nothing but one (a polyhedron)
@@ -149,13 +149,13 @@ class Solid:
         return None
 
     def exact_leaf(self, matrix: np.ndarray) -> Optional[tuple[str, Any]]:
-        """This leaf's exact box test under ``matrix`` for :mod:`csg.classify`."""
+        """This leaf's exact box test under ``matrix`` for :mod:`csg.tree_classifier`."""
         prim = self.world_linf(matrix)
         return None if prim is None else ("exact", prim)
 
     @functools.cached_property
     def exact_plan(self) -> Optional[tuple]:
-        """The tree flattened for exact classification (:func:`csg.classify.plan`),
+        """The tree flattened for exact classification (:func:`csg.tree_classifier.plan`),
         or None when no leaf has an exact test; built once per solid."""
         return plan(self)
 
@@ -176,13 +176,13 @@ class Solid:
     # -- voxelization --------------------------------------------------------------
     @property
     def classify_boxes(self) -> Optional[Callable[[np.ndarray, np.ndarray], np.ndarray]]:
-        """Exact box test (:mod:`csg.classify`) if a leaf has one, else None."""
+        """Exact box test (:mod:`csg.tree_classifier`) if a leaf has one, else None."""
         return exact_classifier(self.exact_plan)
 
     @property
     def classify_voxels(self) -> Optional[Callable[[np.ndarray, np.ndarray], np.ndarray]]:
         """The exact test at the voxel level: as :attr:`classify_boxes`, and where two
-        exact surfaces meet a box, decided by subdividing it (:mod:`csg.classify`), and
+        exact surfaces meet a box, decided by subdividing it (:mod:`csg.tree_classifier`), and
         where they touch (a tie no halving settles) by :attr:`regularized_boundary`."""
         return exact_classifier(self.exact_plan, settle=True,
                                 regularized=lambda: self.regularized_boundary)

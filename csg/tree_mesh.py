@@ -29,7 +29,7 @@ import numpy as np
 from .primitives import (Box, ConvexPolyhedron, Cylinder, Ellipsoid, Polyhedron, Sphere,
                          Torus)
 from .prism import Prism
-from .classify import MeshClassifier
+from .tree_classifier import MeshClassifier
 from .solid import Difference, Intersection, Solid, Transformed, Union, register_regularizer
 
 __all__ = ["tree_mesh", "leaf_mesh", "mesh_volume", "NotAMesh", "regularized_classifier"]
@@ -139,7 +139,7 @@ def tree_mesh(solid: Solid, matrix: np.ndarray) -> tuple[np.ndarray, np.ndarray]
 
 
 def regularized_classifier(solid: Solid):
-    """The exact box test (:class:`~csg.classify.MeshClassifier`) of the boundary of
+    """The exact box test (:class:`~csg.tree_classifier.MeshClassifier`) of the boundary of
     the regularized ``solid``: its :func:`tree_mesh`, whose booleans keep no face
     shared inside the solid; None where the tree has no mesh (a curved leaf, an
     open mesh) or is empty."""

@@ -24,7 +24,7 @@ from .eval.function import Function, compile
 from .octree.grid import Grid
 from .octree.store import Octree, PointerOctree
 from .octree.voxels import Voxels
-from .triangles.bezier import BezierPatch, utah_teapot
+from .triangles.patches import BezierPatch, utah_teapot
 from .triangles.winding import winding_numbers
 from . import linf
 from .linf import linf_distance

@@ -288,3 +288,21 @@ def test_the_tracked_file_check_can_fail(tmp_path, monkeypatch):
     assert len(wrong) == 2
     assert "numpy-2.0-cp311.whl is an archive" in wrong[0]
     assert "big.bin has" in wrong[1]
+
+
+def _layout_section() -> str:
+    text = (ROOT / "README.md").read_text()
+    return text.split("\n## Layout\n", 1)[1].split("\n## ", 1)[0]
+
+
+def test_the_readme_layout_names_every_module():
+    """A newcomer finds every module (and the data folder) on the README's map."""
+    layout = _layout_section()
+    def named(name: str) -> bool:
+        path = name.replace(".", "/")
+        return f"`{name.rsplit('.', 1)[-1]}`" in layout or f"`{path}/`" in layout \
+            or f"`{path}`" in layout or f"`{name}`" in layout
+    missing = [name for name in MODULES if name not in PACKAGES and not named(name)]
+    if not (ROOT / "implicitvox" / "data").is_dir() or "`data/`" not in layout:
+        missing.append("implicitvox/data/")
+    assert not missing, f"the README's Layout does not name: {missing}"

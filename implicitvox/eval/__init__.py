@@ -3,7 +3,7 @@
 ``Expr -> Tape -> point | interval | gradient``: :mod:`.opcodes` (one row per
 operation), :mod:`.tape` (flattened, deduplicated, folded), :mod:`.point`,
 :mod:`.interval`, :mod:`.gradient` and :mod:`.mean_value` (the evaluators),
-:mod:`.oracles` (sweeps, driven by the evaluators), :mod:`.precision` (which
+:mod:`.oracles` (sweeps, driven by the evaluators), :mod:`.float32_tapes` (which
 tapes run in float32), :mod:`.reference` (mpmath, for the tests) and
 :mod:`.function` (``Function``, ``compile``: the user's handle).
 """

@@ -145,6 +145,6 @@ class Function:
                          dtype=np.float64, native: bool = False
                          ) -> tuple[np.ndarray, np.ndarray]:
         """:meth:`interval` on per-axis columns, unchecked (the subdivision's fast path);
-        ``dtype`` float32 only where :func:`implicitvox.octree.precision.interval_dtype` allows;
+        ``dtype`` float32 only where :func:`implicitvox.octree.level_dtype.interval_dtype` allows;
         ``native``: results in ``dtype`` (see :func:`evaluate_intervals`)."""
         return evaluate_intervals(self.tape, lo, hi, dtype, native)

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..interval import kernels as I
+from ..interval import kernels
 from ..interval.float32 import exact_in_float32, float32_bounds, outward_float32
 from .pruning import settle, settle_in_tree
 from .tape import Tape
@@ -40,7 +40,7 @@ def evaluate_intervals(tape: Tape, lo: tuple[np.ndarray, np.ndarray, np.ndarray]
         axis is innermost, where numpy's loops are fast).
     dtype : float64 or float32
         What the kernels compute in. float32 (only for tapes that
-        :func:`implicitvox.octree.precision.interval_dtype` allows) rounds the boxes
+        :func:`implicitvox.octree.level_dtype.interval_dtype` allows) rounds the boxes
         outward to float32 first (bounds already in float32 are taken as they
         are); the enclosures are returned as float64, unless ``native``.
     native : bool, default: False
@@ -90,10 +90,10 @@ def apply_op(op, param, lo: tuple, hi: tuple, single: bool = False):
     if single and op.constant_operand and not exact_in_float32(param):
         clo, chi = float32_bounds(param)
         if op.name == "addc":
-            return I.i_add(lo[0], hi[0], clo, chi)
+            return kernels.i_add(lo[0], hi[0], clo, chi)
         if op.name == "rsubc":
-            return I.i_sub(clo, chi, lo[0], hi[0])
-        return I.i_mul(lo[0], hi[0], clo, chi)
+            return kernels.i_sub(clo, chi, lo[0], hi[0])
+        return kernels.i_mul(lo[0], hi[0], clo, chi)
     return op.interval(lo, hi, param)
 
 

@@ -25,7 +25,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..interval import rounding as R
+from ..interval import rounding
 from .interval import apply_op, evaluate_intervals
 from .tape import Tape
 
@@ -96,15 +96,15 @@ def mean_value_enclosure(tape: Tape, lo, hi, natural=None, chunk: int = 1 << 13
 def _mean_value_form(tape: Tape, lo, hi):
     n = lo[0].shape[0]
     centre = tuple(0.5 * (a + b) for a, b in zip(lo, hi))
-    radius = [R.up_nonneg(np.maximum(c - a, b - c)) for a, b, c in zip(lo, hi, centre)]
+    radius = [rounding.up_nonneg(np.maximum(c - a, b - c)) for a, b, c in zip(lo, hi, centre)]
     clo, chi = evaluate_intervals(tape, centre, centre)
     _, _, glo, ghi, valid = evaluate_interval_gradients(tape, lo, hi)
     spread = np.zeros(n)
     for axis in range(3):
         slope = np.maximum(-glo[axis], ghi[axis])            # max |df/dx_axis| over the box
-        spread = R.up_nonneg(spread + R.up_nonneg(slope * radius[axis]))
+        spread = rounding.up_nonneg(spread + rounding.up_nonneg(slope * radius[axis]))
     with np.errstate(invalid="ignore"):
-        mlo = R.down(clo - spread)
-        mhi = R.up(chi + spread)
+        mlo = rounding.down(clo - spread)
+        mhi = rounding.up(chi + spread)
     keep = valid & np.isfinite(spread) & (clo <= chi) & ~np.isnan(mlo) & ~np.isnan(mhi)
     return mlo, mhi, keep

@@ -22,8 +22,8 @@ import numpy as np
 
 from ..expr.nodes import Expr
 from ..expr.sweeps import FRAMES
-from ..interval import kernels as I
-from ..interval import rounding as R
+from ..interval import kernels
+from ..interval import rounding
 
 __all__ = ["Sweep", "PolarSweep", "compile_oracle", "REFERENCE_DIGITS"]
 
@@ -89,8 +89,8 @@ class Sweep(_Compiled):
         k0 = self._index(axis, lo, -1e-12)
         k1 = self._index(axis, hi, 1e-12)
         half = 0.5 * s
-        a_lo = R.down(lo - R.up(k0 * s))
-        b_hi = R.up(hi - R.down(k1 * s))
+        a_lo = rounding.down(lo - rounding.up(k0 * s))
+        b_hi = rounding.up(hi - rounding.down(k1 * s))
         a_lo = np.where(k0 * s == 0.0, lo, a_lo)  # instance 0: the local frame is the box
         b_hi = np.where(k1 * s == 0.0, hi, b_hi)
         same = k1 == k0
@@ -136,9 +136,9 @@ class Sweep(_Compiled):
                 local_hi.append(ahi)
                 spans |= more
         _, _, clo, chi, valid = run(self.tape, local_lo, local_hi)
-        glo, ghi = I.i_mul(clo[0], chi[0], *g[0])
+        glo, ghi = kernels.i_mul(clo[0], chi[0], *g[0])
         for a in (1, 2):
-            glo, ghi = I.i_add(glo, ghi, *I.i_mul(clo[a], chi[a], *g[a]))
+            glo, ghi = kernels.i_add(glo, ghi, *kernels.i_mul(clo[a], chi[a], *g[a]))
         return (glo, ghi), spans | ~valid  # a box over two instances may jump
 
     def reference(self, args: list, run: Callable):
@@ -212,28 +212,29 @@ class PolarSweep(_Compiled):
         # (sin(float(pi)) is 1.2e-16, not 0), so widen by it as well as by the
         # functions' own relative error.
         slack = np.abs(angle) * (8 * 2.0 ** -52) + 2.0 ** -1000
-        ulps = 2 * R.TRANSCENDENTAL_ULPS
-        clo, chi = R.down(c, ulps) - slack, R.up(c, ulps) + slack
-        slo, shi = R.down(s, ulps) - slack, R.up(s, ulps) + slack
-        lu = I.i_add(*I.i_mul(ulo, uhi, clo, chi), *I.i_mul(vlo, vhi, slo, shi))
-        lv = I.i_sub(*I.i_mul(vlo, vhi, clo, chi), *I.i_mul(ulo, uhi, slo, shi))
+        ulps = 2 * rounding.TRANSCENDENTAL_ULPS
+        clo, chi = rounding.down(c, ulps) - slack, rounding.up(c, ulps) + slack
+        slo, shi = rounding.down(s, ulps) - slack, rounding.up(s, ulps) + slack
+        lu = kernels.i_add(*kernels.i_mul(ulo, uhi, clo, chi), *kernels.i_mul(vlo, vhi, slo, shi))
+        lv = kernels.i_sub(*kernels.i_mul(vlo, vhi, clo, chi), *kernels.i_mul(ulo, uhi, slo, shi))
         return lu, lv
 
     def _sector_box(self, ulo, uhi, vlo, vhi):
         """Bounding box of the fundamental sector between the box's radii."""
-        rlo, rhi = I.i_hypot(ulo, uhi, vlo, vhi)
+        rlo, rhi = kernels.i_hypot(ulo, uhi, vlo, vhi)
         half = self.step / 2
         if half >= np.pi / 2:  # n <= 2: a half plane or the whole plane
             ulo_s = -rhi if half > np.pi / 2 else np.zeros_like(rhi)
             return (ulo_s, rhi), (-rhi, rhi)
-        c, s = R.down(np.cos(half), 8), R.up(np.sin(half), 8)
-        return (R.down_nonneg(rlo * c), rhi), (-R.up_nonneg(rhi * s), R.up_nonneg(rhi * s))
+        c, s = rounding.down(np.cos(half), 8), rounding.up(np.sin(half), 8)
+        reach = rounding.up_nonneg(rhi * s)
+        return (rounding.down_nonneg(rlo * c), rhi), (-reach, reach)
 
     def interval(self, los: tuple, his: tuple, run: Callable):
         shape, cols = _columns(los + his)
         lo, hi = cols[:3], cols[3:]
         (ulo, vlo, wlo), (uhi, vhi, whi) = self._uvw(lo), self._uvw(hi)
-        alo, ahi, whole = I.angle_interval(vlo, vhi, ulo, uhi)
+        alo, ahi, whole = kernels.angle_interval(vlo, vhi, ulo, uhi)
         k0 = np.floor(alo / self.step + 0.5 - 1e-9)
         k1 = np.floor(ahi / self.step + 0.5 + 1e-9)
         many = whole | (k1 - k0 >= 2)

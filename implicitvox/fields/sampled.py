@@ -26,13 +26,13 @@ import numpy as np
 from .. import validate
 from ..expr.nodes import Expr
 from ..expr.shape import as_shape
-from ..linf.mesh import TriangleMesh
+from ..linf.triangle_mesh import TriangleMesh
 from ..octree.run import Run
 from ..triangles.inputs import as_triangles
 from ..voxelizers.implicit import voxelize
 from ..voxelizers.mesh import voxelize_mesh
 from .bricks import BRICK, MAX_BAND, all_bricks, band_bricks, brick_coords
-from .samples import DistanceKernel, band_distances
+from .band_chunks import DistanceKernel, band_distances
 from .field import NORMS, DistanceField
 from .suitability import CRITICAL_RADIUS, SUITABILITY_CHECK_LIMIT, is_suitable_at, solid_voxels
 
@@ -106,7 +106,7 @@ def distance_field(shape: Any, resolution: Union[int, tuple[int, int, int], None
         exceed this many bytes; default half the available memory.
     workers : int, optional
         Processes for the voxelization and the band's samples (chunks of
-        :data:`implicitvox.fields.samples.CHUNK` points farmed out; the same
+        :data:`implicitvox.fields.band_chunks.CHUNK` points farmed out; the same
         values and errors, bit for bit, for any number). Default: every core
         this process may use, one for a small run.
     executor : concurrent.futures.Executor or dask.distributed.Client, optional

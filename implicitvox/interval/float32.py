@@ -1,7 +1,7 @@
 """Float32 interval ends: conversions rounded outward, and what float32 holds exactly.
 
 The subdivision evaluates intervals in float32 where that loses nothing
-visible (:mod:`implicitvox.eval.precision`, :mod:`implicitvox.octree.precision`);
+visible (:mod:`implicitvox.eval.float32_tapes`, :mod:`implicitvox.octree.level_dtype`);
 these are the conversions it needs, each rounded in a stated direction.
 
 Examples

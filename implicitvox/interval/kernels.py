@@ -50,7 +50,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from . import rounding as R
+from . import rounding
 from .filled import filled_like
 
 __all__ = [
@@ -60,14 +60,14 @@ __all__ = [
     "i_distance", "mignitude", "magnitude", "PI_UP", "HALF_PI_UP",
 ]
 
-T = R.TRANSCENDENTAL_ULPS
-P = R.POW_ULPS
+T = rounding.TRANSCENDENTAL_ULPS
+P = rounding.POW_ULPS
 INF = np.inf
 #: Upper bounds of pi and pi/2 (the doubles ``np.pi`` and ``np.pi/2`` lie below).
 PI_UP = float(np.nextafter(np.pi, INF))
 HALF_PI_UP = float(np.nextafter(np.pi / 2, INF))
 _TWO_PI = 2.0 * np.pi
-_TINY = R.LIMITS[np.dtype(np.float64)][1]   # the smallest subnormal double
+_TINY = rounding.LIMITS[np.dtype(np.float64)][1]   # the smallest subnormal double
 
 
 def where_set(mask, value: float, a, owned: bool = False):
@@ -97,21 +97,21 @@ def magnitude(lo, hi):
 
 # -- the four operations ------------------------------------------------------
 def i_add(alo, ahi, blo, bhi):
-    return R.down(alo + blo), R.up(ahi + bhi)
+    return rounding.down(alo + blo), rounding.up(ahi + bhi)
 
 
 def i_sub(alo, ahi, blo, bhi):
-    return R.down(alo - bhi), R.up(ahi - blo)
+    return rounding.down(alo - bhi), rounding.up(ahi - blo)
 
 
 def i_addc(alo, ahi, c: float):
     """``a + c`` for an exact constant ``c`` (``a - c`` is ``a + (-c)``)."""
-    return R.down(alo + c), R.up(ahi + c)
+    return rounding.down(alo + c), rounding.up(ahi + c)
 
 
 def i_rsubc(alo, ahi, c: float):
     """``c - a`` for an exact constant ``c``."""
-    return R.down(c - ahi), R.up(c - alo)
+    return rounding.down(c - ahi), rounding.up(c - alo)
 
 
 def i_mulc(alo, ahi, c: float):
@@ -124,7 +124,7 @@ def i_mulc(alo, ahi, c: float):
             return np.zeros_like(lo), np.zeros_like(hi)
     else:
         lo, hi = ahi * c, alo * c
-    return R.down(lo), R.up(hi)
+    return rounding.down(lo), rounding.up(hi)
 
 
 def i_divc(alo, ahi, c: float):
@@ -132,7 +132,7 @@ def i_divc(alo, ahi, c: float):
     the rounded-outward quotient holds)."""
     with np.errstate(over="ignore"):
         lo, hi = (alo / c, ahi / c) if c > 0.0 else (ahi / c, alo / c)
-    return R.down(lo), R.up(hi)
+    return rounding.down(lo), rounding.up(hi)
 
 
 def i_neg(alo, ahi):
@@ -151,15 +151,15 @@ def i_mul(alo, ahi, blo, bhi):
         lo, hi = _hull4(alo * blo, alo * bhi, ahi * blo, ahi * bhi)
     if np.isnan(lo).any():  # all four corners 0*inf: a = [0, 0], the product is 0
         lo, hi = np.nan_to_num(lo, nan=0.0), np.nan_to_num(hi, nan=0.0)
-    return R.down(lo), R.up(hi)
+    return rounding.down(lo), rounding.up(hi)
 
 
 def i_div(alo, ahi, blo, bhi):
     with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
         lo, hi = _hull4(alo / blo, alo / bhi, ahi / blo, ahi / bhi)
     holds_zero = (blo <= 0.0) & (bhi >= 0.0)
-    lo = np.where(holds_zero, -INF, R.down(lo))
-    hi = np.where(holds_zero, INF, R.up(hi))
+    lo = np.where(holds_zero, -INF, rounding.down(lo))
+    hi = np.where(holds_zero, INF, rounding.up(hi))
     return lo, hi
 
 
@@ -169,7 +169,7 @@ def i_square(alo, ahi):
     mag = magnitude(alo, ahi)
     mig *= mig
     mag *= mag
-    return R.down_nonneg(mig), R.up_nonneg(mag)
+    return rounding.down_nonneg(mig), rounding.up_nonneg(mag)
 
 
 def i_powi(alo, ahi, n: int):
@@ -188,8 +188,8 @@ def i_powi(alo, ahi, n: int):
         if n % 2 == 0:
             lo = np.power(mignitude(alo, ahi), n)
             hi = np.power(magnitude(alo, ahi), n)
-            return R.down_nonneg(lo, P), R.up_nonneg(hi, P)
-        return R.down(np.power(alo, n), P), R.up(np.power(ahi, n), P)
+            return rounding.down_nonneg(lo, P), rounding.up_nonneg(hi, P)
+        return rounding.down(np.power(alo, n), P), rounding.up(np.power(ahi, n), P)
 
 
 def i_powr(alo, ahi, p: float):
@@ -202,14 +202,14 @@ def i_powr(alo, ahi, p: float):
             lo, hi = np.power(a, p), np.power(b, p)
         else:
             lo, hi = np.power(b, p), np.power(a, p)
-    return R.down_nonneg(lo, P), R.up_nonneg(hi, P), empty
+    return rounding.down_nonneg(lo, P), rounding.up_nonneg(hi, P), empty
 
 
 def i_sqrt(alo, ahi):
     empty = ahi < 0.0
     lo = np.sqrt(np.maximum(alo, 0.0))
     hi = np.sqrt(np.maximum(ahi, 0.0))
-    return R.down_nonneg(lo), R.up_nonneg(hi), empty
+    return rounding.down_nonneg(lo), rounding.up_nonneg(hi), empty
 
 
 def i_abs(alo, ahi):
@@ -219,13 +219,13 @@ def i_abs(alo, ahi):
 def i_hypot(alo, ahi, blo, bhi):
     lo = _norm(mignitude(alo, ahi), mignitude(blo, bhi))
     hi = _norm(magnitude(alo, ahi), magnitude(blo, bhi))
-    return R.down_nonneg(lo, P), R.up_nonneg(hi, P)
+    return rounding.down_nonneg(lo, P), rounding.up_nonneg(hi, P)
 
 
 # -- exponential and logarithm -----------------------------------------------------
 def i_exp(alo, ahi):
     with np.errstate(over="ignore"):
-        return R.down_nonneg(np.exp(alo), T), R.up_nonneg(np.exp(ahi), T)
+        return rounding.down_nonneg(np.exp(alo), T), rounding.up_nonneg(np.exp(ahi), T)
 
 
 def i_log(alo, ahi):
@@ -233,7 +233,7 @@ def i_log(alo, ahi):
     with np.errstate(divide="ignore"):
         lo = np.log(np.maximum(alo, 0.0))
         hi = np.log(np.maximum(ahi, 0.0))
-    return R.down(lo, T), R.up(hi, T), empty
+    return rounding.down(lo, T), rounding.up(hi, T), empty
 
 
 # -- trigonometry -------------------------------------------------------------------
@@ -337,15 +337,15 @@ def _periodic(alo, ahi, fast, numpy_values, ulps: int, max_phase: float, min_pha
         top = _extremum_flag(q_lo, q_hi, max_phase)
         bottom = _extremum_flag(q_lo, q_hi, min_phase)
     if single:
-        lo, hi = R.down(np.fmin(fa, fb), T), R.up(np.fmax(fa, fb), T)
+        lo, hi = rounding.down(np.fmin(fa, fb), T), rounding.up(np.fmax(fa, fb), T)
     else:
-        # one subnormal float more than R.down/up give: a halving below 2**-1021 rounds
-        lo = R.down(np.fmin(fa, fb), ulps) - _TINY
-        hi = R.up(np.fmax(fa, fb), ulps) + _TINY
+        # one subnormal float more than rounding.down/up give: a halving below 2**-1021 rounds
+        lo = rounding.down(np.fmin(fa, fb), ulps) - _TINY
+        hi = rounding.up(np.fmax(fa, fb), ulps) + _TINY
     # hi: 1 where a maximum is held (flag >= 1, or NaN: fmin ignores it), else
     # min(hi, 1), which is >= -1 >= flag; lo likewise with the negated flag.
     # (An infinite end makes the flags NaN and the end values NaN, which
-    # R.down/up have turned into the largest floats: the result is [-1, 1].)
+    # rounding.down/up have turned into the largest floats: the result is [-1, 1].)
     one = filled_like(1.0, top)
     hi = np.fmax(np.minimum(hi, one), np.fmin(top, one))
     bottom = np.negative(bottom)
@@ -355,25 +355,25 @@ def _periodic(alo, ahi, fast, numpy_values, ulps: int, max_phase: float, min_pha
 
 
 def i_sin(alo, ahi):
-    return _periodic(alo, ahi, sin_values, np.sin, R.SIN_ULPS, 0.25, 0.75)
+    return _periodic(alo, ahi, sin_values, np.sin, rounding.SIN_ULPS, 0.25, 0.75)
 
 
 def i_cos(alo, ahi):
-    return _periodic(alo, ahi, cos_values, np.cos, R.COS_ULPS, 0.0, 0.5)
+    return _periodic(alo, ahi, cos_values, np.cos, rounding.COS_ULPS, 0.0, 0.5)
 
 
 def i_tan(alo, ahi):
     with np.errstate(invalid="ignore"):
         pole = _holds_phase(*_in_periods(alo, ahi, np.pi), 0.5)
     with np.errstate(invalid="ignore"):
-        lo = R.down(np.tan(alo), T)
-        hi = R.up(np.tan(ahi), T)
+        lo = rounding.down(np.tan(alo), T)
+        hi = rounding.up(np.tan(ahi), T)
     return np.where(pole, -INF, lo), np.where(pole, INF, hi)
 
 
 def i_atan(alo, ahi):
-    lo = R.down(np.arctan(alo), T)
-    hi = R.up(np.arctan(ahi), T)
+    lo = rounding.down(np.arctan(alo), T)
+    hi = rounding.up(np.arctan(ahi), T)
     return np.maximum(lo, filled_like(-HALF_PI_UP, lo)), np.minimum(hi, filled_like(HALF_PI_UP, hi))
 
 
@@ -381,14 +381,14 @@ def i_asin(alo, ahi):
     empty = (ahi < -1.0) | (alo > 1.0)
     a = np.clip(alo, -1.0, 1.0)
     b = np.clip(ahi, -1.0, 1.0)
-    return R.down(np.arcsin(a), T), R.up(np.arcsin(b), T), empty
+    return rounding.down(np.arcsin(a), T), rounding.up(np.arcsin(b), T), empty
 
 
 def i_acos(alo, ahi):
     empty = (ahi < -1.0) | (alo > 1.0)
     a = np.clip(alo, -1.0, 1.0)
     b = np.clip(ahi, -1.0, 1.0)
-    return R.down_nonneg(np.arccos(b), T), R.up_nonneg(np.arccos(a), T), empty
+    return rounding.down_nonneg(np.arccos(b), T), rounding.up_nonneg(np.arccos(a), T), empty
 
 
 def i_atan2(ylo, yhi, xlo, xhi):
@@ -403,8 +403,8 @@ def i_atan2(ylo, yhi, xlo, xhi):
     """
     a1, a2 = np.arctan2(ylo, xlo), np.arctan2(ylo, xhi)
     a3, a4 = np.arctan2(yhi, xlo), np.arctan2(yhi, xhi)
-    lo = R.down(np.minimum(np.minimum(a1, a2), np.minimum(a3, a4)), T)
-    hi = R.up(np.maximum(np.maximum(a1, a2), np.maximum(a3, a4)), T)
+    lo = rounding.down(np.minimum(np.minimum(a1, a2), np.minimum(a3, a4)), T)
+    hi = rounding.up(np.maximum(np.maximum(a1, a2), np.maximum(a3, a4)), T)
     lo, hi = np.maximum(lo, filled_like(-PI_UP, lo)), np.minimum(hi, filled_like(PI_UP, hi))
     full = (xlo <= 0.0) & (ylo <= 0.0) & (yhi >= 0.0)
     return where_set(full, -PI_UP, lo, owned=True), where_set(full, PI_UP, hi, owned=True)
@@ -455,7 +455,7 @@ def i_radius(ulo, uhi, vlo, vhi, wlo, whi):
     """Distance to the origin over a box: from its nearest to its farthest point."""
     lo = _norm(mignitude(ulo, uhi), mignitude(vlo, vhi), mignitude(wlo, whi))
     hi = _norm(magnitude(ulo, uhi), magnitude(vlo, vhi), magnitude(wlo, whi))
-    return R.down_nonneg(lo, 3), R.up_nonneg(hi, 3)
+    return rounding.down_nonneg(lo, 3), rounding.up_nonneg(hi, 3)
 
 
 #: a lower bound of ``sqrt(MAX)``: the least distance whose squared sum overflows
@@ -503,7 +503,7 @@ def i_distance(alo, ahi, blo, bhi, wlo, whi, centre):
     n1, f1 = _offset_square_extents(blo, bhi, c1)
     n2, f2 = _offset_square_extents(wlo, whi, c2)
     near, far = np.sqrt((n0 + n1) + n2), np.sqrt((f0 + f1) + f2)
-    eps = R.limits(near)[0]
+    eps = rounding.limits(near)[0]
     underflow_root, sqrt_max_down = _DISTANCE_LIMITS[near.dtype == np.float32]
     lo = near * (1.0 - 3.0 * eps) - underflow_root
     hi = far * (1.0 + 3.0 * eps) + underflow_root
@@ -521,13 +521,13 @@ def i_elevation(ulo, uhi, vlo, vhi, wlo, whi):
     the axis has ``rho_lo = 0``, giving ``+-pi/2`` as it should; the branch cut
     of ``atan2`` is never met because ``rho >= 0``.
     """
-    rlo = R.down_nonneg(_norm(mignitude(ulo, uhi), mignitude(vlo, vhi)), P)
-    rhi = R.up_nonneg(_norm(magnitude(ulo, uhi), magnitude(vlo, vhi)), P)
+    rlo = rounding.down_nonneg(_norm(mignitude(ulo, uhi), mignitude(vlo, vhi)), P)
+    rhi = rounding.up_nonneg(_norm(magnitude(ulo, uhi), magnitude(vlo, vhi)), P)
     # rho_hi where w >= 0 else rho_lo, and the reverse, chosen without np.where
     # (slow on mixed masks): 0 <= rho_lo <= rho_hi, and rho_lo is never -0
     lo = np.arctan2(wlo, np.fmax(rlo, rhi * (wlo >= 0.0)))
     hi = np.arctan2(whi, np.fmax(rlo, rhi * (whi < 0.0)))
-    lo, hi = R.down(lo, T), R.up(hi, T)
+    lo, hi = rounding.down(lo, T), rounding.up(hi, T)
     return np.maximum(lo, filled_like(-HALF_PI_UP, lo)), np.minimum(hi, filled_like(HALF_PI_UP, hi))
 
 
@@ -558,10 +558,10 @@ def _unwrapped_angle(vlo, vhi, ulo, uhi):
         v_lo, v_hi, u_hi = (np.broadcast_to(a, cut.shape)[where] for a in (vlo, vhi, uhi))
         lo = np.array(np.broadcast_to(lo, cut.shape), order="C")
         hi = np.array(np.broadcast_to(hi, cut.shape), order="C")
-        lo.reshape(-1)[flat] = R.down(np.arctan2(v_hi, u_hi), T)
+        lo.reshape(-1)[flat] = rounding.down(np.arctan2(v_hi, u_hi), T)
         # v = +0 is on the upper side (atan2 gives +pi there): as -0 it gives -pi,
         # and the unwrapped end pi, not 3 pi
-        hi.reshape(-1)[flat] = R.up(R.up(np.arctan2(np.copysign(v_lo, -1.0), u_hi), T)
+        hi.reshape(-1)[flat] = rounding.up(rounding.up(np.arctan2(np.copysign(v_lo, -1.0), u_hi), T)
                                     + TWO_PI_UP)
     return lo, hi
 

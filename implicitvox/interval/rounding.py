@@ -72,7 +72,7 @@ COS_ULPS = 2 * TRANSCENDENTAL_ULPS + 2
 #: the spacing of floats at 1 (one ulp of 1.0)
 EPS = 2.0 ** -52
 #: per float type: (spacing at 1, smallest subnormal, largest finite); the
-#: interval kernels also run on float32 (:mod:`implicitvox.eval.precision`)
+#: interval kernels also run on float32 (:mod:`implicitvox.eval.float32_tapes`)
 LIMITS = {np.dtype(np.float64): (EPS, 2.0 ** -1074, float(np.finfo(np.float64).max)),
           np.dtype(np.float32): (2.0 ** -23, 2.0 ** -149, float(np.finfo(np.float32).max))}
 _F64 = LIMITS[np.dtype(np.float64)]

@@ -4,7 +4,7 @@ Each primitive gives the signed weighted max-norm distance of points (negative
 inside; ``weights`` per axis, or per point, for non-cubic voxels) and
 ``classify_boxes(lo, hi)``: EMPTY / FULL / AMBIGUOUS, where AMBIGUOUS means
 the surface meets the closed box - exactly, up to rounding at ties
-(:mod:`implicitvox.linf.classify`).
+(:mod:`implicitvox.linf.box_tests`).
 
 * :class:`HalfSpace`, :class:`ConvexPolyhedron` (boxes, oriented boxes, any
   bounded intersection of half-spaces or convex hull) - §3.1.1, §3.1.2;
@@ -35,8 +35,8 @@ from typing import Any
 
 import numpy as np
 
-from .classify import Primitive, classify_by_distance
-from .mesh import TriangleMesh
+from .box_tests import Primitive, classify_by_distance
+from .triangle_mesh import TriangleMesh
 from .polyhedron import ConvexPolyhedron, HalfSpace, convex_hull_faces, triangle_distance
 from .sphere import Sphere
 from .ellipsoid import Ellipsoid

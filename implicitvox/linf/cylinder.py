@@ -40,7 +40,7 @@ import numpy as np
 from .. import expr as ex
 
 from .ellipsoid import quadratic_roots
-from .classify import Primitive
+from .box_tests import Primitive
 from .euclidean import meridian, segment_distance
 from .norm import as_points, as_weights
 from .products import dot

@@ -29,7 +29,7 @@ from typing import Any, NamedTuple, Optional
 import numpy as np
 
 from .. import expr as ex
-from .classify import Primitive
+from .box_tests import Primitive
 from .euclidean import triangle_distance as triangle_euclidean
 from .norm import as_points, as_weights, in_blocks
 from .products import dot

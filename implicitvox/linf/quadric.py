@@ -40,7 +40,7 @@ import numpy as np
 
 from .. import expr as ex
 
-from .classify import Primitive
+from .box_tests import Primitive
 from .norm import as_points, as_weights
 from .products import dot
 

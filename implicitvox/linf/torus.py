@@ -42,7 +42,7 @@ import numpy as np
 
 from .. import expr as ex
 
-from .classify import Primitive
+from .box_tests import Primitive
 from .euclidean import meridian
 from .norm import as_points, as_weights, float_bisection, in_blocks
 from .torus_frame import TorusFrame

@@ -56,7 +56,7 @@ from typing import Any, Callable, Optional
 import numpy as np
 
 from ..eval.function import Function
-from ..interval import rounding as R
+from ..interval import rounding
 from ..eval.interval import evaluate_intervals
 from ..eval.mean_value import evaluate_interval_gradients
 from ..eval.point import evaluate_points
@@ -184,7 +184,7 @@ def _monotone(func: Any, grid: Grid, level: int, coords: np.ndarray
         valid = np.asarray(valid) & np.isfinite(glo).all(0) & np.isfinite(ghi).all(0)
         one_sided = np.minimum(np.maximum(ghi, 0.0), np.maximum(-glo, 0.0))       # (3, n)
         width = np.stack([h - l for l, h in zip(lo, hi)])
-        leak = R.up_nonneg((one_sided * width).sum(0) * (1 + 1e-12))
+        leak = rounding.up_nonneg((one_sided * width).sum(0) * (1 + 1e-12))
         scale = np.maximum(np.abs(glo), np.abs(ghi)).max(0)
     leak = np.where(valid, leak, np.inf)
     # no gradient enclosure (a sweep's instances, a singular point): splitting tells no
@@ -202,7 +202,7 @@ def _corners_exclude(func: Any, grid: Grid, level: int, coords: np.ndarray,
     with np.errstate(all="ignore"):
         flo, fhi = evaluate_intervals(_tape(func), pos, pos)
         flo, fhi = flo.reshape(-1, 8), fhi.reshape(-1, 8)
-        return (R.down(flo.min(1) - leak) > 0) | (R.up(fhi.max(1) + leak) < 0)
+        return (rounding.down(flo.min(1) - leak) > 0) | (rounding.up(fhi.max(1) + leak) < 0)
 
 
 def _tape(func: Any) -> Tape:

@@ -3,7 +3,7 @@
 * :mod:`.grid` - the voxel grid (cubic voxels by default) and octant boxes;
 * :mod:`.morton` - Morton codes of voxel indices;
 * :mod:`.subdivide` - EMPTY / FULL / AMBIGUOUS octants by interval arithmetic (Stolte §2);
-* :mod:`.precision` - which float type each level's intervals run in;
+* :mod:`.level_dtype` - which float type each level's intervals run in;
 * :mod:`.store` - the pointer octree (Stolte §5.1): ``Octree``, ``PointerOctree``;
 * :mod:`.voxels` - ``Voxels``, the result; it knows its producer only as a source object.
 """

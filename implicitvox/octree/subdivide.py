@@ -19,7 +19,7 @@ chunk is an independent set of subtrees (the unit a parallel driver hands
 out; Stolte §5.2). Octants travel as Morton codes (a child is ``parent << 3
 | slot``), so the surface voxels come out ready for the pointer octree, and
 the interval evaluation runs in float32 where
-:func:`implicitvox.octree.precision.interval_dtype` allows it (about 3 times
+:func:`implicitvox.octree.level_dtype.interval_dtype` allows it (about 3 times
 faster, still rounded outward).
 """
 from __future__ import annotations
@@ -39,9 +39,9 @@ from .grid import Grid
 from .guard import MemoryGuard
 from . import morton
 from ..eval.mean_value import mean_value_enclosure
-from .precision import interval_dtype, level_dtype
+from .level_dtype import interval_dtype, level_dtype
 from ..interval.float32 import outward_float32
-from ..eval.precision import supports_float32
+from ..eval.float32_tapes import supports_float32
 from ..expr.shape import AMBIGUOUS, EMPTY, FULL, Octants, takes_octants
 from .. import batches
 
@@ -109,7 +109,7 @@ def classify(func: Function, grid: Grid, level: int, coords: np.ndarray,
     ``mean_value``, then the shape's exact test. A box's state depends on the
     box alone, not on the level or the run, so ``Voxels.refine`` matches a
     direct voxelization: the natural extension runs in the float type that
-    :func:`implicitvox.octree.precision.interval_dtype` picks for the box size
+    :func:`implicitvox.octree.level_dtype.interval_dtype` picks for the box size
     (``dtype`` None), or in ``dtype``. ``run``: the subdivision's scratch space,
     for an exact test that takes the octants (:class:`~implicitvox.expr.shape.Octants`).
     """

@@ -10,7 +10,7 @@
 * :mod:`.fill` - the interior of closed meshes;
 * :mod:`.bezier` - Bézier patches, De Casteljau subdivision, the Utah teapot.
 """
-from .bezier import BezierPatch, bezier_triangles, utah_teapot
+from .patches import BezierPatch, bezier_triangles, utah_teapot
 from .inputs import MESH_SUFFIXES, as_triangles
 from .tribox import Triangles
 from .winding import winding_numbers

@@ -56,7 +56,7 @@ class Triangles:
     A triangle with a ``dilation`` ``d`` (per axis) stands for the set of
     points within ``d`` of it in the weighted max-norm: a box meets it iff the
     box grown by ``d`` (rounded outward) meets the triangle. That is how
-    :mod:`implicitvox.triangles.bezier` covers a curved patch with two flat triangles.
+    :mod:`implicitvox.triangles.patches` covers a curved patch with two flat triangles.
 
     Attributes
     ----------

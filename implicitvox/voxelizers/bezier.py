@@ -1,7 +1,7 @@
 """``voxelize_bezier``: every voxel a Bézier patch meets (Stolte §4.2).
 
 The patches are cut into flat pieces with a certified distance
-(:func:`implicitvox.triangles.bezier.bezier_triangles`), and the pieces, grown by
+(:func:`implicitvox.triangles.patches.bezier_triangles`), and the pieces, grown by
 that distance, voxelized exactly (:mod:`implicitvox.triangles.pairs`).
 
 Examples
@@ -19,7 +19,7 @@ from typing import Any, Callable, Iterable, Optional, Union
 import numpy as np
 
 from .. import validate
-from ..triangles.bezier import BezierPatch, bezier_triangles
+from ..triangles.patches import BezierPatch, bezier_triangles
 from ..triangles.tribox import Triangles
 from ..octree.grid import Grid, grid_of
 from ..octree.run import Run

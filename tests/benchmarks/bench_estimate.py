@@ -1,6 +1,6 @@
 """Benchmark: the pilot's estimate of the surface voxels against the count a run finds.
 
-Run: ``python tests/benchmarks/bench_estimate.py [--res 256 512] [--full]``
+Run: ``python tests/benchmarks/bench_estimate.py [--res 256 512] [--full] [--models NAME ...]``
 
 A run is refused before it starts when its estimated memory passes the budget,
 so the estimate is what a user reads first. For the seven comparison models
@@ -45,6 +45,7 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--res", type=int, nargs="+", default=[256, 512])
     parser.add_argument("--full", action="store_true", help="sin1000 at 512³ and above too")
+    parser.add_argument("--models", nargs="+", help="only these (default: all)")
     args = parser.parse_args()
     load = tables.load_average()
     rows, worst = [], 1.0
@@ -52,6 +53,8 @@ def main() -> None:
               "voxels found", "estimate / found", "pilot s", "run s")
     print(" | ".join(header))
     for name, make in models().items():
+        if args.models and name not in args.models:
+            continue
         shape = as_shape(make())
         for res in args.res:
             if name == "sin1000" and res > 256 and not args.full:

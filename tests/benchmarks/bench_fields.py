@@ -46,7 +46,7 @@ QUICK = {"bunny-linf": 128, "torus": 256, "sinsin34": 48}
 def _shape(name: str):
     from implicitvox import linf
     from implicitvox.expr.examples import example
-    from implicitvox.linf.mesh import TriangleMesh
+    from implicitvox.linf.triangle_mesh import TriangleMesh
     from implicitvox.triangles.inputs import as_triangles
     if name == "bunny-linf":
         return TriangleMesh(*as_triangles(os.path.abspath(BUNNY)))

@@ -16,7 +16,7 @@ Prints, single process:
    ``mean_value=True``, ``subvoxel=1`` and ``mean_value=True, subvoxel=2``.
 
 The interval evaluation runs in float32 for these models at every level
-(:func:`implicitvox.octree.precision.interval_dtype`; the "fp" column).
+(:func:`implicitvox.octree.level_dtype.interval_dtype`; the "fp" column).
 """
 from __future__ import annotations
 
@@ -28,7 +28,7 @@ import numpy as np
 import implicitvox as ivx
 from implicitvox.expr.examples import sinsin
 from implicitvox.octree.grid import Grid
-from implicitvox.octree.precision import interval_dtype
+from implicitvox.octree.level_dtype import interval_dtype
 
 try:
     from tests.benchmarks import tables

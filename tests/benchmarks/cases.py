@@ -38,15 +38,13 @@ def sinsin918() -> Any:
 
 
 def blended_spheres() -> Any:
-    """Ten spheres of radius 0.3 to 0.5 joined by smooth unions (radius 0.15)."""
-    from csg import Sphere, smooth_union
+    """Ten blobby spheres (Stolte's blended spheres: a sum of Gaussians) of radius 0.3
+    to 0.5, their centres in the unit cube."""
+    from csg import Blobby
     rng = np.random.default_rng(10)
-    centres = rng.uniform(-0.7, 0.7, size=(10, 3))
+    centres = rng.uniform(-0.6, 0.6, size=(10, 3))
     radii = rng.uniform(0.3, 0.5, size=10)
-    solid = Sphere(float(radii[0])).translate(tuple(centres[0]))
-    for c, r in zip(centres[1:], radii[1:]):
-        solid = smooth_union(solid, Sphere(float(r)).translate(tuple(c)), 0.15)
-    return solid
+    return Blobby(centres.tolist(), radii.tolist())
 
 
 def menger3() -> Any:

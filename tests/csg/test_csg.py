@@ -114,7 +114,7 @@ def test_which_solids_have_an_exact_test():
     assert Sphere(1).classify_boxes is not None               # max-norm distance
     assert Torus(1, 0.2).rotate((0, 1, 0), 90).classify_boxes is not None
     assert (csg.ExprSolid(ivx.x ** 2 - 1) - Polyhedron(SPHERE_MESH)).classify_boxes is not None
-    from csg.classify import world_primitive as world_linf
+    from csg.tree_classifier import world_primitive as world_linf
     assert world_linf(Torus(1, 0.2).rotate((1, 1, 0), 30)).axis is None  # general orientation
     assert world_linf(Torus(0.2, 0.3).rotate((1, 1, 0), 30)) is None  # tilted spindle torus
     assert world_linf(Torus(0.2, 0.3).rotate((1, 0, 0), 90)) is not None  # upright: exact
@@ -307,18 +307,18 @@ def test_settling_drops_voxels_where_two_surfaces_cancel():
     both spheres and miss the union's surface. Settling (halving such voxels) drops
     them, and only them: every dropped voxel is wholly inside the union (17^3 samples)
     and the rest of the output is unchanged."""
-    import csg.classify as C
+    from csg import tree_classifier
     centres, radii = np.array([[-0.3, 0.01, 0.02], [0.35, -0.02, 0.0]]), np.array([0.6, 0.5])
     union = Sphere(radii[0]).translate(tuple(centres[0])) | \
         Sphere(radii[1]).translate(tuple(centres[1]))
     settled = union.voxelize(64)
-    depth = C.SETTLE_DEPTH
+    depth = tree_classifier.SETTLE_DEPTH
     try:
-        C.SETTLE_DEPTH = 0
+        tree_classifier.SETTLE_DEPTH = 0
         union.__dict__.pop("_classifier_cache", None)
         conservative = union.voxelize(64, bounds=settled.bounds)
     finally:
-        C.SETTLE_DEPTH = depth
+        tree_classifier.SETTLE_DEPTH = depth
     assert settled.grid == conservative.grid
     kept = conservative.contains(settled.coords())
     assert kept.all()
@@ -345,7 +345,7 @@ def _unculled(node):
 
 
 def test_culling_children_by_their_support_changes_no_state():
-    from csg.classify import exact_classifier, plan
+    from csg.tree_classifier import exact_classifier, plan
     rng = np.random.default_rng(11)
     for _ in range(12):
         parts = []
@@ -373,7 +373,7 @@ def test_corner_witnesses_settle_as_halving_does(monkeypatch):
     as OpenSCAD's example010 intersects a heightmap with its turned copy), across the
     gap between two meshes (where halving finds the boxes EMPTY, and no witness may
     say otherwise), and with interval leaves."""
-    from csg import classify
+    from csg import tree_classifier as classify
     turned = Polyhedron(SPHERE_MESH) & Polyhedron(SPHERE_MESH).rotate((1, 2, 3), 7)
     apart = Polyhedron(SPHERE_MESH) & Polyhedron(SPHERE_MESH).translate((2.02, 0, 0))
     blend = Polyhedron(SPHERE_MESH) - smooth_union(Sphere(0.4), Sphere(0.4, center=(0.5, 0, 0)),
@@ -405,7 +405,7 @@ def test_corner_witnesses_settle_as_halving_does(monkeypatch):
 def _every_child(plan: tuple, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
     """The states of a plan by its rules, every child asked about every box (the
     reference for the classifier, which skips children where another decided)."""
-    from csg import classify
+    from csg import tree_classifier as classify
     kind = plan[0]
     if kind in ("union", "intersection"):
         states = np.array([_every_child(k, lo, hi) for k in plan[1]])
@@ -428,7 +428,7 @@ def test_children_decided_by_another_are_skipped_and_change_no_state(monkeypatch
     """A box one child makes absorbing (EMPTY in an intersection, FULL in a union)
     asks no other child, the interval leaves last; the states are those of asking
     every child, in both orders of the operands."""
-    from csg import classify
+    from csg import tree_classifier as classify
     blend = smooth_union(Sphere(0.4), Sphere(0.4, center=(0.5, 0, 0)), 0.2)
     slab = Box((2, 0.4, 2), center=True)
     trees = [Polyhedron(SPHERE_MESH) - blend, blend - Polyhedron(SPHERE_MESH),

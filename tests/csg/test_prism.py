@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 import csg
-from csg.classify import MeshClassifier
+from csg.tree_classifier import MeshClassifier
 from csg.clipper2d import region_pieces
 from csg.prism import Prism, axis_permutation
 

@@ -1,4 +1,4 @@
-"""Interval evaluation in float32 (:mod:`implicitvox.eval.precision`): the same promise.
+"""Interval evaluation in float32 (:mod:`implicitvox.eval.float32_tapes`): the same promise.
 
 The kernels of the opcode rows marked ``float32`` run on float32 boxes (rounded outward from
 the float64 ones) and must still enclose the exact range (mpmath, 60 digits);
@@ -28,9 +28,9 @@ from implicitvox.eval.opcodes import OPCODES
 from implicitvox.eval.reference import apply_reference
 from implicitvox.expr.shape import ExprShape
 from implicitvox.eval.opcodes import OPCODES
-from implicitvox.eval.precision import supports_float32
+from implicitvox.eval.float32_tapes import supports_float32
 from implicitvox.interval.float32 import float32_bounds, outward_float32
-from implicitvox.octree.precision import interval_dtype, level_dtype
+from implicitvox.octree.level_dtype import interval_dtype, level_dtype
 from tests.support.reference import DPS, contains
 from tests.support.surface import found, surface_brackets
 from tests.support.strategies import elements_for, interval, param_for, samples

@@ -11,9 +11,9 @@ import pyvista as pv
 import csg
 import implicitvox as iv
 from implicitvox import linf, x, y, z
-from implicitvox.linf.classify import TIE_ULPS
+from implicitvox.linf.box_tests import TIE_ULPS
 from implicitvox.fields.bricks import band_bricks
-from implicitvox.fields.kernels import linf_by_box_test
+from implicitvox.fields.distance_kernels import linf_by_box_test
 from implicitvox.linf.euclidean import triangle_distance as triangle_euclidean
 from implicitvox.triangles.inputs import as_triangles
 

@@ -501,9 +501,14 @@ def test_torus_errors_and_voxels():
         linf.Torus((0, 0, 0), "w", 1.0, 0.2)
 
 
-def _circle_box_distance(R, lo, hi, n=2048, basins=3):
+def _circle_box_distance(R, lo, hi, n=2048, basins=3, chunk=2048):
     """Euclidean distance from the circle of radius R about the z axis (z = 0) to boxes:
-    a dense sweep of the circle, refined by golden sections around its best minima."""
+    a dense sweep of the circle, refined by golden sections around its best minima
+    (``chunk`` boxes at a time: the sweep holds ``n`` points per box)."""
+    if len(lo) > chunk:
+        return np.concatenate([_circle_box_distance(R, lo[s:s + chunk], hi[s:s + chunk], n,
+                                                    basins, chunk)
+                               for s in range(0, len(lo), chunk)])
     u = np.arange(n) * (2 * np.pi / n)
 
     def dist(uu):

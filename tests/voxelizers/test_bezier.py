@@ -6,7 +6,7 @@ import pytest
 
 import implicitvox as ivx
 from implicitvox.octree import morton
-from implicitvox.triangles.bezier import bezier_triangles
+from implicitvox.triangles.patches import bezier_triangles
 from tests.support.mesh_helpers import misses
 
 

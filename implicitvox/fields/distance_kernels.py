@@ -31,7 +31,7 @@ from typing import Any, Callable, Optional
 import numpy as np
 
 from ..expr.shape import AMBIGUOUS, FULL, voxel_classifier
-from ..linf.classify import TIE_ULPS
+from ..linf.box_tests import TIE_ULPS
 from ..linf.norm import float_bisection
 
 __all__ = ["Kernel", "choose_kernel", "exact_distance_function", "linf_by_box_test"]
@@ -74,7 +74,7 @@ def linf_by_box_test(classify: Callable, points: np.ndarray, weights: Any,
                      limit: float = np.inf) -> tuple[np.ndarray, np.ndarray]:
     """Signed weighted max-norm distances from an exact box test, by bisection on the
     bit patterns of the cube's half-size (64 steps at most); error one ulp of the
-    distance plus the box test's allowance for rounding (``linf.classify.TIE_ULPS``).
+    distance plus the box test's allowance for rounding (``linf.box_tests.TIE_ULPS``).
     ``limit`` caps the search (points farther get ``±limit``)."""
     p = np.asarray(points, dtype=np.float64)
     n = len(p)
@@ -102,7 +102,7 @@ def linf_by_box_test(classify: Callable, points: np.ndarray, weights: Any,
     far = ~meets(hi)
     t = np.where(far, hi, t)
     # the box test counts a cube within its rounding of touching as met
-    # (linf.classify.TIE_ULPS, in units of the centre's ulp over the half-size): the
+    # (linf.box_tests.TIE_ULPS, in units of the centre's ulp over the half-size): the
     # distance may be that much short, taken twice for the distance's own rounding
     reach = np.abs(p).max(axis=1) / w.min(axis=1)
     tie = 2 * TIE_ULPS * np.finfo(np.float64).eps * (2 * t + reach)

@@ -1,6 +1,6 @@
 """Which float type the subdivision's interval evaluation runs in, per octree level.
 
-A tape that can run in float32 (:func:`implicitvox.eval.precision.supports_float32`)
+A tape that can run in float32 (:func:`implicitvox.eval.float32_tapes.supports_float32`)
 does so at a level only where the boxes themselves lose little: rounding a
 corner to float32 moves it by at most ``2**-24 |x|``, which must stay below
 1/1024 of the box. The choice depends on the boxes' size, not on the grid's
@@ -23,7 +23,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..eval.precision import supports_float32
+from ..eval.float32_tapes import supports_float32
 from ..eval.tape import Tape
 from .grid import Grid
 

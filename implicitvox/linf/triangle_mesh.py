@@ -33,7 +33,7 @@ import numpy as np
 from ..triangles.crossings import RayWinding
 from ..triangles.inputs import as_triangles
 from ..octree import morton
-from .classify import Primitive
+from .box_tests import Primitive
 from .norm import as_points, as_weights, in_blocks
 from .polyhedron import triangle_distance
 from .euclidean import triangle_distance as triangle_euclidean

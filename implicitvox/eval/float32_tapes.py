@@ -7,7 +7,7 @@ in float32. libfive and Fidget evaluate their intervals in single precision
 for the same reason. Outward rounding makes it as safe as float64 (the same
 kernels, widened by float32 ulps, :data:`rounding.LIMITS`); it only costs
 tightness where float32's 2**-24 is not small against a voxel, so
-:func:`implicitvox.octree.precision.interval_dtype` picks it only where
+:func:`implicitvox.octree.level_dtype.interval_dtype` picks it only where
 
 * every instruction of the tape is one whose kernel handles float32
   (the row's ``float32``), with its parameters exact in float32 (a constant
@@ -19,7 +19,7 @@ tightness where float32's 2**-24 is not small against a voxel, so
 Each opcode row says whether its kernel handles float32
 (:attr:`~implicitvox.eval.opcodes.Opcode.float32`) and, for rows with a
 parameter, whether float32 holds it (``float32_params``); the level rule is
-in :mod:`implicitvox.octree.precision`.
+in :mod:`implicitvox.octree.level_dtype`.
 
 Examples
 --------

@@ -15,12 +15,12 @@ from typing import Any, Optional
 import numpy as np
 
 from ..eval.function import Function
-from ..linf.mesh import TriangleMesh
+from ..linf.triangle_mesh import TriangleMesh
 from ..octree.grid import Grid
 from ..octree.run import Run
 from ..parallel import Job, farm
 from .certified import certified_distances
-from .kernels import Kernel, choose_kernel
+from .distance_kernels import Kernel, choose_kernel
 
 __all__ = ["DistanceKernel", "SamplesJob", "band_distances", "CHUNK", "COST"]
 
@@ -54,7 +54,7 @@ class DistanceKernel:
 
     @functools.cached_property
     def kernel(self) -> Kernel:
-        """:func:`~implicitvox.fields.kernels.choose_kernel`'s kernel for the target."""
+        """:func:`~implicitvox.fields.distance_kernels.choose_kernel`'s kernel for the target."""
         return choose_kernel(self.target, self.norm, self._certify)
 
     def _certify(self, points: np.ndarray, weights: Any):
