@@ -35,10 +35,12 @@ from typing import Any, Optional
 
 import numpy as np
 
-from .planar import Circle, Polygon, Rectangle, pieces_polygon
-from .solid import Difference, Intersection, Solid, Transformed, Union
+from .planar import Polygon, pieces_polygon
+from .protocol import NotFlat, fold
+from .solid import Solid
 
-__all__ = ["region_paths", "region_pieces", "simple_pieces", "offset", "to_polygon", "clip",
+__all__ = ["region_paths", "boolean_paths", "region_pieces", "simple_pieces", "offset",
+           "to_polygon", "clip",
            "to_clipper", "check_range", "OutOfRange", "CLIPPER_SCALE", "CLIPPER_RANGE",
            "MITER_LIMIT", "NotFlat"]
 
@@ -49,10 +51,6 @@ CLIPPER_RANGE = float((1 << 62) - 1)
 #: OpenSCAD's ``offset`` miter limit (``delta`` keeps every corner sharp)
 MITER_LIMIT = 1_000_000.0
 _JOINS = {"round": "JT_ROUND", "miter": "JT_MITER", "square": "JT_SQUARE"}
-
-
-class NotFlat(ValueError):
-    """A 2D tree with a leaf that has no outline (a true circle: facet it first)."""
 
 
 class OutOfRange(ValueError):
@@ -116,36 +114,25 @@ def region_paths(solid: Solid, matrix: Optional[np.ndarray] = None) -> list:
     NotFlat
         A leaf with no outline (a true :class:`~csg.planar.Circle`).
     """
-    matrix = np.eye(4) if matrix is None else matrix
-    if isinstance(solid, Transformed):
-        return region_paths(solid.children[0], matrix @ solid.matrix)
-    if isinstance(solid, (Union, Difference, Intersection)):
-        parts = [region_paths(c, matrix) for c in solid.children]
-        if isinstance(solid, Union):
-            return clip([p for part in parts for p in part], [], "CT_UNION")
-        if isinstance(solid, Difference):
-            return clip(parts[0], [p for part in parts[1:] for p in part], "CT_DIFFERENCE")
-        out = parts[0]
-        for part in parts[1:]:
-            out = clip(out, part, "CT_INTERSECTION")
-        return out
-    outlines = _leaf_outlines(solid)
-    moved = [o @ matrix[:2, :2].T + matrix[:2, 3] for o in outlines]
-    paths = _usable([to_clipper(o) for o in moved])
-    return clip(paths, [], "CT_UNION", "PFT_EVENODD")      # OpenSCAD's sanitize
+    def leaf(node: Solid, moved: np.ndarray) -> list:
+        outlines = [o @ moved[:2, :2].T + moved[:2, 3] for o in node.outlines()]
+        paths = _usable([to_clipper(o) for o in outlines])
+        return clip(paths, [], "CT_UNION", "PFT_EVENODD")      # OpenSCAD's sanitize
+
+    return fold(solid, leaf, boolean_paths, matrix)
 
 
-def _leaf_outlines(solid: Solid) -> list[np.ndarray]:
-    if isinstance(solid, Rectangle):
-        lo = -solid.size / 2 if solid.centered else np.zeros(2)
-        hi = lo + solid.size
-        return [np.array([[lo[0], lo[1]], [hi[0], lo[1]], [hi[0], hi[1]], [lo[0], hi[1]]])]
-    if isinstance(solid, Polygon):
-        return [solid.points[p] for p in solid.paths]
-    if isinstance(solid, Circle):
-        raise NotFlat("a true circle has no outline (facet it first, as OpenSCAD does: "
-                      "read_openscad(..., facets='openscad'))")
-    raise NotFlat(f"a {type(solid).__name__} is not a 2D shape with outlines")
+def boolean_paths(operation: str, parts: list) -> list:
+    """Clipper's result of a boolean (``"union"``, ``"difference"``,
+    ``"intersection"``) of its operands' integer paths, as OpenSCAD computes it."""
+    if operation == "union":
+        return clip([p for part in parts for p in part], [], "CT_UNION")
+    if operation == "difference":
+        return clip(parts[0], [p for part in parts[1:] for p in part], "CT_DIFFERENCE")
+    out = parts[0]
+    for part in parts[1:]:
+        out = clip(out, part, "CT_INTERSECTION")
+    return out
 
 
 def region_pieces(solid: Solid) -> list[tuple[np.ndarray, list[np.ndarray]]]:

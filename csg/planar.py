@@ -33,6 +33,7 @@ import implicitvox as iv
 from implicitvox import Expr, validate, x, y, z
 
 from .facets import FULL_SWEEP_START, polygonal_radius
+from .protocol import NotAMesh, NotAPolytope, NotFlat
 from .solid import Bounds, Solid, Union
 from .triangulate import triangulate
 
@@ -46,6 +47,13 @@ class Shape2D(Solid):
 
 class Circle(Shape2D):
     """Disc of radius ``r`` about the origin."""
+
+    curved = True
+
+    def outlines(self) -> list[np.ndarray]:
+        """A true circle has none."""
+        raise NotFlat("a true circle has no outline (facet it first, as OpenSCAD does: "
+                      "read_openscad(..., facets='openscad'))")
 
     def __init__(self, r: float = 1.0):
         self.r = validate.positive_number(r, "r")
@@ -92,9 +100,30 @@ class Rectangle(Shape2D):
     def __repr__(self) -> str:
         return f"Rectangle(size={self.size.tolist()}, center={self.centered})"
 
+    def outlines(self) -> list[np.ndarray]:
+        """Its 4 corners, counter-clockwise."""
+        lo = -self.size / 2 if self.centered else np.zeros(2)
+        hi = lo + self.size
+        return [np.array([[lo[0], lo[1]], [hi[0], lo[1]], [hi[0], hi[1]], [lo[0], hi[1]]])]
+
+    def polytope_vertices(self, convex: bool, pieces: Any) -> np.ndarray:
+        """Its 4 corners at z = 0."""
+        lo = -self.size / 2 if self.centered else np.zeros(2)
+        hi = lo + self.size
+        return np.array([[lo[0], lo[1], 0], [hi[0], lo[1], 0], [hi[0], hi[1], 0],
+                         [lo[0], hi[1], 0]], dtype=np.float64)
+
     def scene_node(self) -> dict:
         """This node of a JSON scene (:mod:`csg.scene`)."""
         return {"type": "rectangle", "size": self.size.tolist(), "center": self.centered}
+
+
+def _convex_either_way(poly: np.ndarray) -> bool:
+    """Never turning right, or never turning left (within rounding)."""
+    d = np.roll(poly, -1, axis=0) - poly
+    cross = d[:, 0] * np.roll(d, -1, axis=0)[:, 1] - d[:, 1] * np.roll(d, -1, axis=0)[:, 0]
+    scale = np.abs(d).max() ** 2
+    return bool(np.all(cross >= -1e-12 * scale) or np.all(cross <= 1e-12 * scale))
 
 
 def _convex(poly: np.ndarray) -> bool:
@@ -331,6 +360,20 @@ class Polygon(Shape2D):
     def __repr__(self) -> str:
         return f"Polygon({len(self.points)} points, {len(self.paths)} paths)"
 
+    def outlines(self) -> list[np.ndarray]:
+        """Its paths' points."""
+        return [self.points[p] for p in self.paths]
+
+    def polytope_vertices(self, convex: bool, pieces: Any) -> np.ndarray:
+        """The points its pieces use, at z = 0; with ``convex``, of one convex outline."""
+        if convex and (len(self.pieces) != 1 or self.pieces[0][1] or
+                       not _convex_either_way(self.points[self.paths[self.pieces[0][0]]])):
+            raise NotAPolytope("a non-convex polygon in a Minkowski sum (its convex "
+                               "decomposition is not built: split it into convex parts)")
+        used = sorted({i for k, _ in self.pieces for i in self.paths[k]})
+        p = self.points[used]
+        return np.column_stack([p, np.zeros(len(p))])
+
     def scene_node(self) -> dict:
         """This node of a JSON scene (:mod:`csg.scene`)."""
         return {"type": "polygon", "points": self.points.tolist(), "paths": self.paths}
@@ -457,6 +500,28 @@ class LinearExtrude(Solid):
         return (f"linear_extrude({self._children[0]!r}, height={self.height}, "
                 f"twist={self.twist}, scale={self.scale_top.tolist()}, center={self.centered})")
 
+    def polytope_vertices(self, convex: bool, pieces: Any) -> np.ndarray:
+        """Its section's vertices at the bottom and, scaled, at the top (a twist is
+        curved); with ``convex``, of a section of one convex piece."""
+        if self.twist != 0:
+            raise NotAPolytope("a twisted linear_extrude is curved: its hull is no polytope "
+                               "(facet it first: read_openscad(..., facets='openscad'))",
+                               curved=True)
+        if convex and len(pieces(self.children[0], True)) != 1:
+            raise NotAPolytope("an extrusion of several pieces in a Minkowski sum "
+                               "(split it into one extrusion per convex piece)")
+        flat = np.concatenate(pieces(self.children[0], False))
+        z0 = -self.height / 2 if self.centered else 0.0
+        bottom = np.column_stack([flat, np.full(len(flat), z0)])
+        top = np.column_stack([flat * self.scale_top, np.full(len(flat), z0 + self.height)])
+        return np.concatenate([bottom, top])
+
+    def closed_mesh(self) -> tuple[np.ndarray, np.ndarray]:
+        """None here: a straight extrusion of OpenSCAD's is a prism (:class:`csg.prism.Prism`)."""
+        raise NotAMesh(f"a {type(self).__name__} has no triangle mesh here (polyhedra, "
+                       "imported meshes, surfaces, boxes and faceted primitives have)",
+                       curved=True)
+
     def scene_node(self) -> dict:
         """This node of a JSON scene (:mod:`csg.scene`)."""
         return {"type": "linear_extrude", "height": self.height, "twist": self.twist,
@@ -518,6 +583,12 @@ class RotateExtrude(Solid):
 
     def __repr__(self) -> str:
         return f"rotate_extrude({self._children[0]!r}, angle={self.angle})"
+
+    def closed_mesh(self) -> tuple[np.ndarray, np.ndarray]:
+        """None here: it sweeps its section round."""
+        raise NotAMesh(f"a {type(self).__name__} has no triangle mesh here (polyhedra, "
+                       "imported meshes, surfaces, boxes and faceted primitives have)",
+                       curved=True)
 
     def scene_node(self) -> dict:
         """This node of a JSON scene (:mod:`csg.scene`)."""

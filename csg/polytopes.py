@@ -27,7 +27,7 @@ Examples
 >>> hull(Sphere(1), Box((1, 1, 1)))
 Traceback (most recent call last):
 ...
-csg.polytopes.NotAPolytope: a Sphere is curved: its hull or Minkowski sum is no polytope (facet it first, as OpenSCAD does: read_openscad(..., facets='openscad'))
+csg.protocol.NotAPolytope: a Sphere is curved: its hull or Minkowski sum is no polytope (facet it first, as OpenSCAD does: read_openscad(..., facets='openscad'))
 """
 from __future__ import annotations
 
@@ -35,11 +35,12 @@ from typing import Any
 
 import numpy as np
 
-from .clipper2d import CLIPPER_SCALE, NotFlat, region_paths
-from .planar import Circle, LinearExtrude, Polygon, Rectangle
-from .primitives import Box, ConvexPolyhedron, Cylinder, Ellipsoid, Polyhedron, Sphere, Torus
-from .solid import Solid, Transformed, Union
-from .tree_mesh import NotAMesh, mesh_volume, tree_mesh
+from .clipper2d import CLIPPER_SCALE, region_paths
+from .planar import Polygon
+from .primitives import ConvexPolyhedron, Polyhedron
+from .protocol import NotAMesh, NotAPolytope, NotFlat, fold
+from .solid import Solid, Union
+from .tree_mesh import tree_mesh
 
 __all__ = ["hull", "minkowski", "vertices", "convex_pieces", "convex_solid", "NotAPolytope",
            "MAX_PLANES", "MAX_PIECES", "MAX_SUMS"]
@@ -51,19 +52,6 @@ MAX_PLANES = 64
 MAX_PIECES = 10_000
 #: the vertex sums (over all pieces) a Minkowski sum may compute
 MAX_SUMS = 10_000_000
-
-_CURVED = (Sphere, Cylinder, Torus, Ellipsoid, Circle)
-
-
-class NotAPolytope(ValueError):
-    """A solid with no vertex set: curved, or (for a Minkowski sum) a non-convex
-    piece."""
-
-    def __init__(self, message: str, curved: bool = False):
-        super().__init__(message)
-        #: the reason is a curved surface (facetting the solid would make it a polytope)
-        self.curved = curved
-
 
 def vertices(solid: Solid) -> np.ndarray:
     """The vertices of a polytope tree: (n, 3), or (n, 2) for a 2D shape; their
@@ -91,75 +79,25 @@ def convex_pieces(solid: Solid, convex: bool = True) -> list[np.ndarray]:
 
 
 def _pieces(solid: Solid, matrix: np.ndarray, convex: bool) -> list[np.ndarray]:
-    dim = solid.dim
-    if isinstance(solid, Transformed):
-        return _pieces(solid.children[0], matrix @ solid.matrix, convex)
-    if isinstance(solid, Union):
-        return [p for child in solid.children for p in _pieces(child, matrix, convex)]
-    points = _leaf_vertices(solid, convex)
-    if dim == 2:
-        return [points[:, :2] @ matrix[:2, :2].T + matrix[:2, 3]]
-    return [points @ matrix[:3, :3].T + matrix[:3, 3]]
+    """The tree walked (:func:`csg.protocol.fold`) through its unions and transforms:
+    each leaf's :meth:`~csg.solid.Solid.polytope_vertices`, a difference's or
+    intersection's result (:func:`_boolean_vertices`), moved."""
+    def leaf(node: Solid, moved: np.ndarray) -> list[np.ndarray]:
+        if node.operation in ("difference", "intersection"):
+            if convex:
+                name = type(node).__name__.lower()
+                raise NotAPolytope(f"a {name} in a Minkowski sum (its result is not convex "
+                                   "in general, and its convex decomposition is not built: "
+                                   "split it into convex parts)")
+            points = _boolean_vertices(node)
+        else:
+            points = node.polytope_vertices(convex, convex_pieces)
+        if node.dim == 2:
+            return [points[:, :2] @ moved[:2, :2].T + moved[:2, 3]]
+        return [points @ moved[:3, :3].T + moved[:3, 3]]
 
-
-def _leaf_vertices(solid: Solid, convex: bool) -> np.ndarray:
-    name = type(solid).__name__
-    if isinstance(solid, _CURVED):
-        raise NotAPolytope(f"a {name} is curved: its hull or Minkowski sum is no polytope "
-                           "(facet it first, as OpenSCAD does: read_openscad(..., "
-                           "facets='openscad'))", curved=True)
-    if isinstance(solid, Box):
-        lo = -solid.size / 2 if solid.centered else np.zeros(3)
-        corners = np.array([[i, j, k] for i in (0, 1) for j in (0, 1) for k in (0, 1)])
-        return lo + corners * solid.size
-    if isinstance(solid, ConvexPolyhedron):
-        if solid.points is None:
-            raise NotAPolytope("a ConvexPolyhedron given by planes has no vertex list "
-                               "(give points=)")
-        return solid.points
-    if isinstance(solid, Polyhedron):
-        used = np.unique(solid.faces.ravel())
-        v = solid.vertices[used]
-        if convex and not _is_convex(solid.vertices, solid.faces):
-            raise NotAPolytope("a non-convex Polyhedron in a Minkowski sum (its convex "
-                               "decomposition is not built: split it into convex parts)")
-        return v
-    if isinstance(solid, Rectangle):
-        lo = -solid.size / 2 if solid.centered else np.zeros(2)
-        hi = lo + solid.size
-        return np.array([[lo[0], lo[1], 0], [hi[0], lo[1], 0], [hi[0], hi[1], 0],
-                         [lo[0], hi[1], 0]], dtype=np.float64)
-    if isinstance(solid, Polygon):
-        if convex and (len(solid.pieces) != 1 or solid.pieces[0][1] or
-                       not _is_convex_polygon(solid.points[solid.paths[solid.pieces[0][0]]])):
-            raise NotAPolytope("a non-convex polygon in a Minkowski sum (its convex "
-                               "decomposition is not built: split it into convex parts)")
-        used = sorted({i for k, _ in solid.pieces for i in solid.paths[k]})
-        p = solid.points[used]
-        return np.column_stack([p, np.zeros(len(p))])
-    if isinstance(solid, LinearExtrude):
-        if solid.twist != 0:
-            raise NotAPolytope("a twisted linear_extrude is curved: its hull is no polytope "
-                               "(facet it first: read_openscad(..., facets='openscad'))",
-                               curved=True)
-        if convex:
-            base = convex_pieces(solid.children[0], convex=True)
-            if len(base) != 1:
-                raise NotAPolytope("an extrusion of several pieces in a Minkowski sum "
-                                   "(split it into one extrusion per convex piece)")
-        flat = vertices(solid.children[0])
-        z0 = -solid.height / 2 if solid.centered else 0.0
-        bottom = np.column_stack([flat, np.full(len(flat), z0)])
-        top = np.column_stack([flat * solid.scale_top, np.full(len(flat), z0 + solid.height)])
-        return np.concatenate([bottom, top])
-    if name in ("Difference", "Intersection"):
-        if convex:
-            raise NotAPolytope(f"a {name.lower()} in a Minkowski sum (its result is not "
-                               "convex in general, and its convex decomposition is not "
-                               "built: split it into convex parts)")
-        return _boolean_vertices(solid)
-    raise NotAPolytope(f"a {name} has no vertex set here (hull and minkowski take boxes, "
-                       "polyhedra, polygons, straight extrusions, moved and united)")
+    return fold(solid, leaf, lambda operation, parts: [p for part in parts for p in part],
+                matrix, booleans=("union",))
 
 
 def _boolean_vertices(solid: Solid) -> np.ndarray:
@@ -183,24 +121,6 @@ def _boolean_vertices(solid: Solid) -> np.ndarray:
     if not len(f):
         raise NotAPolytope(f"the {type(solid).__name__.lower()} is empty: no vertices")
     return v[np.unique(f.ravel())]
-
-
-def _is_convex_polygon(poly: np.ndarray) -> bool:
-    d = np.roll(poly, -1, axis=0) - poly
-    cross = d[:, 0] * np.roll(d, -1, axis=0)[:, 1] - d[:, 1] * np.roll(d, -1, axis=0)[:, 0]
-    scale = np.abs(d).max() ** 2
-    return bool(np.all(cross >= -1e-12 * scale) or np.all(cross <= 1e-12 * scale))
-
-
-def _is_convex(v: np.ndarray, f: np.ndarray) -> bool:
-    """Whether a closed mesh is convex: its volume equals its hull's."""
-    from scipy.spatial import ConvexHull, QhullError
-    volume = abs(mesh_volume(v, f))
-    try:
-        whole = ConvexHull(v[np.unique(f.ravel())]).volume
-    except QhullError:
-        return False
-    return bool(abs(whole - volume) <= 1e-9 * whole)
 
 
 def convex_solid(points: Any) -> Solid:

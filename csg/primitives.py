@@ -22,10 +22,12 @@ import numpy as np
 
 import implicitvox as iv
 from implicitvox import Expr, validate, linf, x, y, z
+from implicitvox.triangles.closed import hull_mesh, is_convex_mesh
 from implicitvox.triangles.inputs import as_triangles
 from implicitvox.octree.morton import CORNERS
 
 from .tree_classifier import MeshClassifier, similarity_scale
+from .protocol import NotAPolytope
 from .solid import Bounds, Solid, box_bound, vector
 
 __all__ = ["Sphere", "Box", "Cylinder", "Torus", "Ellipsoid", "HalfSpace", "ConvexPolyhedron",
@@ -57,6 +59,8 @@ def _box(lo: Sequence[float], hi: Sequence[float]) -> Bounds:
 
 class Sphere(Solid):
     """Ball of radius ``r`` about ``center``: ``|p - c| - r``."""
+
+    curved = True
 
     def __init__(self, r: float = 1.0, center: Sequence[float] = (0, 0, 0)):
         self.r = _positive(r, "r")
@@ -121,6 +125,16 @@ class Box(Solid):
         corners = np.where(CORNERS.astype(bool), hi, lo)
         return linf.ConvexPolyhedron.from_points(corners @ matrix[:3, :3].T + matrix[:3, 3])
 
+    def polytope_vertices(self, convex: bool, pieces: Any) -> np.ndarray:
+        """Its 8 corners."""
+        lo = -self.size / 2 if self.centered else np.zeros(3)
+        corners = np.array([[i, j, k] for i in (0, 1) for j in (0, 1) for k in (0, 1)])
+        return lo + corners * self.size
+
+    def closed_mesh(self) -> tuple[np.ndarray, np.ndarray]:
+        """The hull of its corners: 12 triangles."""
+        return hull_mesh(self.polytope_vertices(True, None))
+
     def __repr__(self) -> str:
         return f"Box(size={self.size.tolist()}, center={self.centered})"
 
@@ -132,6 +146,8 @@ class Box(Solid):
 class Cylinder(Solid):
     """Cylinder, cone or frustum along z: radius ``r1`` at the bottom, ``r2`` at the top
     (or ``r`` for both), height ``h``, from ``z = 0`` or centred."""
+
+    curved = True
 
     def __init__(self, h: float = 1.0, r: Optional[float] = None, r1: Optional[float] = None,
                  r2: Optional[float] = None, center: bool = False):
@@ -192,6 +208,8 @@ class Cylinder(Solid):
 class Torus(Solid):
     """Torus about the z axis: major radius ``R``, minor radius ``r``."""
 
+    curved = True
+
     def __init__(self, R: float = 1.0, r: float = 0.25):
         self.R, self.r = _positive(R, "R"), _positive(r, "r")
 
@@ -228,6 +246,8 @@ class Torus(Solid):
 
 class Ellipsoid(Solid):
     """Ellipsoid with semi-axes ``radii`` about ``center``."""
+
+    curved = True
 
     def __init__(self, radii: Sequence[float] = (1, 1, 1), center: Sequence[float] = (0, 0, 0)):
         r = _point(radii, "radii")
@@ -351,6 +371,19 @@ class ConvexPolyhedron(Solid):
 
     exact = True
 
+    def polytope_vertices(self, convex: bool, pieces: Any) -> np.ndarray:
+        """The points it was given (a polytope given by planes has none)."""
+        if self.points is None:
+            raise NotAPolytope("a ConvexPolyhedron given by planes has no vertex list "
+                               "(give points=)")
+        return self.points
+
+    def closed_mesh(self) -> tuple[np.ndarray, np.ndarray]:
+        """The hull of its points (a polytope given by planes has no mesh)."""
+        if self.points is None:
+            return super().closed_mesh()
+        return hull_mesh(np.asarray(self.points, dtype=np.float64))
+
     def world_linf(self, matrix: np.ndarray) -> linf.Primitive:
         if self.points is not None:
             return linf.ConvexPolyhedron.from_points(self.points @ matrix[:3, :3].T + matrix[:3, 3])
@@ -402,6 +435,18 @@ class Polyhedron(Solid):
 
     def world_linf(self, matrix: np.ndarray) -> linf.Primitive:
         return linf.TriangleMesh(self._world_vertices(matrix), self.faces)
+
+    def polytope_vertices(self, convex: bool, pieces: Any) -> np.ndarray:
+        """The vertices its faces use; with ``convex``, only of a convex mesh."""
+        used = np.unique(self.faces.ravel())
+        if convex and not is_convex_mesh(self.vertices, self.faces):
+            raise NotAPolytope("a non-convex Polyhedron in a Minkowski sum (its convex "
+                               "decomposition is not built: split it into convex parts)")
+        return self.vertices[used]
+
+    def closed_mesh(self) -> tuple[np.ndarray, np.ndarray]:
+        """Its own vertices and faces."""
+        return self.vertices, np.asarray(self.faces)
 
     def exact_leaf(self, matrix: np.ndarray) -> tuple[str, Any]:
         flip = np.linalg.det(matrix[:3, :3]) < 0      # mirrored: the winding sign flips

@@ -209,6 +209,10 @@ class Prism(LinearExtrude):
             v = v @ matrix[:3, :3].T + matrix[:3, 3]
         return v, f
 
+    def closed_mesh(self) -> tuple[np.ndarray, np.ndarray]:
+        """Its walls and caps (:meth:`mesh`)."""
+        return self.mesh()
+
     def exact_leaf(self, matrix: np.ndarray) -> tuple[str, Any]:
         axes = axis_permutation(matrix[:3, :3])
         if axes is None:

@@ -37,10 +37,11 @@ from typing import Optional
 
 import numpy as np
 
-from .clipper2d import clip, to_clipper, to_polygon
+from .clipper2d import boolean_paths, clip, to_clipper, to_polygon
 from .planar import Polygon
-from .solid import Difference, Intersection, Solid, Transformed, Union
-from .tree_mesh import NotAMesh, leaf_mesh, tree_mesh
+from .protocol import NotAMesh, fold
+from .solid import Solid
+from .tree_mesh import leaf_mesh, tree_mesh
 
 __all__ = ["projection", "leaf_mesh", "section_outlines", "NotAMesh"]
 
@@ -88,29 +89,22 @@ def section_outlines(vertices: np.ndarray, faces: np.ndarray) -> list[np.ndarray
 
 
 def _cut_paths(solid: Solid, matrix: np.ndarray) -> list:
-    if isinstance(solid, Transformed):
-        return _cut_paths(solid.children[0], matrix @ solid.matrix)
-    if isinstance(solid, (Union, Difference, Intersection)):
-        parts = [_cut_paths(c, matrix) for c in solid.children]
-        if isinstance(solid, Union):
-            return clip([p for part in parts for p in part], [], "CT_UNION")
-        if isinstance(solid, Difference):
-            return clip(parts[0], [p for part in parts[1:] for p in part], "CT_DIFFERENCE")
-        out = parts[0]
-        for part in parts[1:]:
-            out = clip(out, part, "CT_INTERSECTION")
-        return out
-    loops = section_outlines(*leaf_mesh(solid, matrix))
-    return clip([to_clipper(loop) for loop in loops], [], "CT_UNION", "PFT_EVENODD")
+    """The section by z = 0 through every boolean (a section distributes over them):
+    each leaf's mesh sliced, the outlines combined by Clipper."""
+    def leaf(node: Solid, moved: np.ndarray) -> list:
+        loops = section_outlines(*leaf_mesh(node, moved))
+        return clip([to_clipper(loop) for loop in loops], [], "CT_UNION", "PFT_EVENODD")
+
+    return fold(solid, leaf, boolean_paths, matrix)
 
 
 def _shadow_paths(solid: Solid, matrix: np.ndarray) -> list:
-    if isinstance(solid, Transformed):
-        return _shadow_paths(solid.children[0], matrix @ solid.matrix)
-    if isinstance(solid, Union):
-        return clip([p for c in solid.children for p in _shadow_paths(c, matrix)], [],
-                     "CT_UNION")
-    # the shadow of a difference or intersection is that of the boolean's result
+    """The shadow on z = 0 through the unions; below a difference or intersection, the
+    shadow of the boolean's result (its mesh by Manifold), as OpenSCAD projects it."""
+    return fold(solid, _result_shadow, boolean_paths, matrix, booleans=("union",))
+
+
+def _result_shadow(solid: Solid, matrix: np.ndarray) -> list:
     v, f = tree_mesh(solid, matrix)
     if not len(f):
         return []

@@ -34,6 +34,7 @@ import numpy as np
 import implicitvox as iv
 from implicitvox import Expr, validate, x, y, z
 
+from .protocol import NotAMesh, NotAPolytope, NotFlat
 from .tree_classifier import exact_classifier, plan, world_primitive
 
 __all__ = ["Solid", "Union", "Intersection", "Difference", "Complement", "Transformed",
@@ -57,10 +58,13 @@ def register_regularizer(build: Callable[["Solid"], Optional[Any]]) -> None:
 
 
 class Solid:
-    """Base class of CSG nodes (see the module docstring)."""
+    """Base class of CSG nodes (see the module docstring); what a leaf must and may
+    provide is the leaf protocol of :mod:`csg.protocol`."""
 
     #: 3 for solids; 2 for planar regions (infinite prisms along z, for extrusions)
     dim = 3
+    #: whether the surface has true curves (no vertices, mesh or outlines: facet it)
+    curved = False
     #: what the exact classifier (:mod:`csg.tree_classifier`) reads of a node: its
     #: operation ("union", "intersection", "difference", "complement",
     #: "transform"; None for leaves and other nodes), whether it is a leaf with
@@ -147,6 +151,52 @@ class Solid:
         """This leaf under the affine ``matrix`` as a max-norm primitive
         (:mod:`implicitvox.linf`), or None (the default: no exact form)."""
         return None
+
+    # -- the optional hooks of the leaf protocol (csg.protocol) ---------------------------
+    def polytope_vertices(self, convex: bool, pieces: Callable[["Solid", bool], list]
+                          ) -> np.ndarray:
+        """The points (n, 3) whose convex hull is this leaf, for hulls and Minkowski
+        sums (:mod:`csg.polytopes`); by default it has none.
+
+        Raises
+        ------
+        NotAPolytope
+            This leaf has no vertex set (curved ones say so).
+        """
+        name = type(self).__name__
+        if self.curved:
+            raise NotAPolytope(f"a {name} is curved: its hull or Minkowski sum is no polytope "
+                               "(facet it first, as OpenSCAD does: read_openscad(..., "
+                               "facets='openscad'))", curved=True)
+        raise NotAPolytope(f"a {name} has no vertex set here (hull and minkowski take boxes, "
+                           "polyhedra, polygons, straight extrusions, moved and united)")
+
+    def closed_mesh(self) -> tuple[np.ndarray, np.ndarray]:
+        """This leaf's closed triangle mesh ``(vertices, faces)`` in its own frame
+        (:mod:`csg.tree_mesh`); by default it has none.
+
+        Raises
+        ------
+        NotAMesh
+            This leaf has no mesh (curved ones say so).
+        """
+        name = type(self).__name__
+        if self.curved:
+            raise NotAMesh(f"a {name} is curved: it has no mesh (facet it first: "
+                           "read_openscad(..., facets='openscad'))", curved=True)
+        raise NotAMesh(f"a {name} has no triangle mesh here (polyhedra, imported meshes, "
+                       "surfaces, boxes and faceted primitives have)")
+
+    def outlines(self) -> list[np.ndarray]:
+        """A 2D leaf's closed outlines ((k, 2) arrays, filled even-odd) for Clipper
+        (:mod:`csg.clipper2d`); by default it has none.
+
+        Raises
+        ------
+        NotFlat
+            This is no 2D leaf with outlines.
+        """
+        raise NotFlat(f"a {type(self).__name__} is not a 2D shape with outlines")
 
     def exact_leaf(self, matrix: np.ndarray) -> Optional[tuple[str, Any]]:
         """This leaf's exact box test under ``matrix`` for :mod:`csg.tree_classifier`."""

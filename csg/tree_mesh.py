@@ -26,43 +26,13 @@ from __future__ import annotations
 
 import numpy as np
 
-from .primitives import (Box, ConvexPolyhedron, Cylinder, Ellipsoid, Polyhedron, Sphere,
-                         Torus)
-from .prism import Prism
+from implicitvox.triangles.closed import mesh_volume
+
+from .protocol import NotAMesh, fold
 from .tree_classifier import MeshClassifier
-from .solid import Difference, Intersection, Solid, Transformed, Union, register_regularizer
+from .solid import Solid, register_regularizer
 
 __all__ = ["tree_mesh", "leaf_mesh", "mesh_volume", "NotAMesh", "regularized_classifier"]
-
-_CURVED = (Sphere, Cylinder, Torus, Ellipsoid)
-
-
-class NotAMesh(ValueError):
-    """A 3D leaf with no triangle mesh (curved, or a kind with no mesh here), or a
-    boolean whose operands are not closed meshes."""
-
-    def __init__(self, message: str, curved: bool = False):
-        super().__init__(message)
-        #: the reason is a curved leaf (its facets would do)
-        self.curved = curved
-
-
-def mesh_volume(vertices: np.ndarray, faces: np.ndarray) -> float:
-    """The signed volume of a closed triangle mesh (positive when oriented outward)."""
-    a, b, c = (vertices[faces[:, k]] for k in range(3))
-    return float(np.einsum("ij,ij->i", a, np.cross(b, c)).sum() / 6.0)
-
-
-def _hull_mesh(points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """The convex hull's triangles, each oriented by the hull's outward normal."""
-    from scipy.spatial import ConvexHull
-    hull = ConvexHull(points)
-    f = hull.simplices.copy()
-    a, b, c = (points[f[:, k]] for k in range(3))
-    inward = np.einsum("ij,ij->i", np.cross(b - a, c - a), hull.equations[:, :3]) < 0
-    f[inward] = f[inward][:, ::-1]
-    return points, f
-
 
 def leaf_mesh(solid: Solid, matrix: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """The closed triangle mesh (vertices, faces) of a polytope leaf, moved by
@@ -73,44 +43,33 @@ def leaf_mesh(solid: Solid, matrix: np.ndarray) -> tuple[np.ndarray, np.ndarray]
     NotAMesh
         A curved leaf (``curved`` set), or a kind of leaf with no mesh here.
     """
-    if isinstance(solid, _CURVED):
-        raise NotAMesh(f"a {type(solid).__name__} is curved: it has no mesh "
-                       "(facet it first: read_openscad(..., facets='openscad'))", curved=True)
-    if isinstance(solid, Polyhedron):
-        v, f = solid.vertices, np.asarray(solid.faces)
-    elif isinstance(solid, Prism):
-        v, f = solid.mesh()
-    elif isinstance(solid, ConvexPolyhedron) and solid.points is not None:
-        v, f = _hull_mesh(np.asarray(solid.points, dtype=np.float64))
-    elif isinstance(solid, Box):
-        lo = -solid.size / 2 if solid.centered else np.zeros(3)
-        corners = np.array([[i, j, k] for i in (0, 1) for j in (0, 1) for k in (0, 1)])
-        v, f = _hull_mesh(lo + corners * solid.size)
-    else:
-        raise NotAMesh(f"a {type(solid).__name__} has no triangle mesh here (polyhedra, "
-                       "imported meshes, surfaces, boxes and faceted primitives have)",
-                       curved=type(solid).__name__ in ("LinearExtrude", "RotateExtrude"))
+    v, f = solid.closed_mesh()
     v = v @ matrix[:3, :3].T + matrix[:3, 3]
     if mesh_volume(v, f) < 0:                 # given inward (or mirrored by the matrix)
         f = f[:, ::-1]
     return v, f
 
 
+_MANIFOLD_OPS = {"union": "Add", "difference": "Subtract", "intersection": "Intersect"}
+
+
 def _manifold(solid: Solid, matrix: np.ndarray):
+    """The tree as a Manifold: each leaf's :func:`leaf_mesh`, each boolean computed in
+    its own frame and then moved (as OpenSCAD moves its result: faces that coincide
+    in that frame still coincide, where moving each operand's vertices first would
+    round them apart into slivers)."""
     import manifold3d
-    if isinstance(solid, Transformed):
-        child, moved = solid.children[0], matrix @ solid.matrix
-        if isinstance(child, (Union, Difference, Intersection)):
-            # a boolean in its own frame, then moved (as OpenSCAD moves its result): faces
-            # that coincide in that frame still coincide, where moving each operand's
-            # vertices first would round them apart into slivers
-            return _manifold(child, np.eye(4)).transform(np.ascontiguousarray(moved[:3, :4]))
-        return _manifold(child, moved)
-    if isinstance(solid, (Union, Difference, Intersection)):
-        op = {Union: manifold3d.OpType.Add, Difference: manifold3d.OpType.Subtract,
-              Intersection: manifold3d.OpType.Intersect}[type(solid)]
-        return manifold3d.Manifold.batch_boolean([_manifold(c, matrix) for c in solid.children],
-                                                 op)
+
+    def combine(operation: str, parts: list):
+        op = getattr(manifold3d.OpType, _MANIFOLD_OPS[operation])
+        return manifold3d.Manifold.batch_boolean(parts, op)
+
+    return fold(solid, _leaf_manifold, combine, matrix,
+                moved=lambda made, m: made.transform(np.ascontiguousarray(m[:3, :4])))
+
+
+def _leaf_manifold(solid: Solid, matrix: np.ndarray):
+    import manifold3d
     v, f = leaf_mesh(solid, matrix)
     mesh = manifold3d.Mesh64(vert_properties=np.ascontiguousarray(v, dtype=np.float64),
                              tri_verts=np.ascontiguousarray(f, dtype=np.uint64))
@@ -131,7 +90,7 @@ def tree_mesh(solid: Solid, matrix: np.ndarray) -> tuple[np.ndarray, np.ndarray]
         A leaf as :func:`leaf_mesh` refuses, or one whose mesh is not closed and
         manifold (Manifold's status named).
     """
-    if not isinstance(solid, (Transformed, Union, Difference, Intersection)):
+    if solid.operation not in ("transform", "union", "difference", "intersection"):
         return leaf_mesh(solid, matrix)
     result = _manifold(solid, matrix).to_mesh64()
     v = np.asarray(result.vert_properties, dtype=np.float64)[:, :3]

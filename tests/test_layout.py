@@ -306,3 +306,62 @@ def test_the_readme_layout_names_every_module():
     if not (ROOT / "implicitvox" / "data").is_dir() or "`data/`" not in layout:
         missing.append("implicitvox/data/")
     assert not missing, f"the README's Layout does not name: {missing}"
+
+
+def _solid_classes() -> list[type]:
+    import importlib
+    import inspect
+    from csg.solid import Solid
+    found = []
+    for name in MODULES:
+        if not name.startswith("csg"):
+            continue
+        module = importlib.import_module(name)
+        found += [obj for obj in vars(module).values()
+                  if inspect.isclass(obj) and issubclass(obj, Solid) and obj.__module__ == name]
+    return found
+
+
+def _protocol_faults(classes: list[type]) -> list[str]:
+    """What the leaf classes among ``classes`` lack of the leaf protocol (csg.protocol),
+    and the optional hooks defined with other parameters than it names."""
+    import inspect
+    from csg.protocol import OPTIONAL, REQUIRED
+    from csg.solid import Solid
+    faults = []
+    for cls in classes:
+        if cls.operation is not None or cls is Solid:
+            continue                            # booleans and transforms are no leaves
+        missing = [m for m in REQUIRED if getattr(cls, m) is getattr(Solid, m)]
+        if missing and not cls.__subclasses__():     # a base of leaves may leave them
+            faults.append(f"{cls.__module__}.{cls.__name__} lacks {missing}")
+        for hook, wanted in OPTIONAL.items():
+            if hook in vars(cls):
+                got = tuple(list(inspect.signature(vars(cls)[hook]).parameters)[1:])
+                if got != wanted:
+                    faults.append(f"{cls.__module__}.{cls.__name__}.{hook} takes {got}, "
+                                  f"the protocol {wanted}")
+    return faults
+
+
+def test_every_leaf_class_provides_the_leaf_protocol():
+    classes = _solid_classes()
+    assert len(classes) > 15
+    faults = _protocol_faults(classes)
+    assert not faults, "\n".join(faults)
+
+
+def test_the_leaf_protocol_check_can_fail():
+    from csg.solid import Solid
+
+    class NoFunction(Solid):
+        @property
+        def bounds(self):
+            return None
+
+        def closed_mesh(self, matrix):
+            return None
+
+    faults = _protocol_faults([NoFunction])
+    assert any("lacks ['expr', 'scene_node']" in f for f in faults)
+    assert any("closed_mesh takes ('matrix',), the protocol ()" in f for f in faults)

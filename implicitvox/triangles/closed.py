@@ -1,0 +1,49 @@
+"""Closed triangle meshes: the signed volume, the convex hull as an outward mesh, convexity.
+
+Examples
+--------
+>>> import numpy as np
+>>> corners = np.array([[i, j, k] for i in (0, 1) for j in (0, 1) for k in (0, 2)], float)
+>>> v, f = hull_mesh(corners)
+>>> mesh_volume(v, f), is_convex_mesh(v, f)
+(2.0, True)
+"""
+from __future__ import annotations
+
+import numpy as np
+
+__all__ = ["mesh_volume", "hull_mesh", "is_convex_mesh", "CONVEX_TOLERANCE"]
+
+#: a mesh is convex when its volume is its hull's within this share of the hull's
+CONVEX_TOLERANCE = 1e-9
+
+
+def mesh_volume(vertices: np.ndarray, faces: np.ndarray) -> float:
+    """The signed volume of a closed triangle mesh (positive when oriented outward)."""
+    a, b, c = (vertices[faces[:, k]] for k in range(3))
+    return float(np.einsum("ij,ij->i", a, np.cross(b, c)).sum() / 6.0)
+
+
+def hull_mesh(points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The convex hull of ``points`` (n, 3) as triangles ``(points, faces)``, each
+    oriented by the hull's outward normal (scipy's Qhull)."""
+    from scipy.spatial import ConvexHull
+    points = np.asarray(points, dtype=np.float64)
+    hull = ConvexHull(points)
+    f = hull.simplices.copy()
+    a, b, c = (points[f[:, k]] for k in range(3))
+    inward = np.einsum("ij,ij->i", np.cross(b - a, c - a), hull.equations[:, :3]) < 0
+    f[inward] = f[inward][:, ::-1]
+    return points, f
+
+
+def is_convex_mesh(vertices: np.ndarray, faces: np.ndarray) -> bool:
+    """Whether a closed mesh is convex: its volume equals its hull's (within
+    :data:`CONVEX_TOLERANCE`); False for a flat one."""
+    from scipy.spatial import ConvexHull, QhullError
+    volume = abs(mesh_volume(vertices, faces))
+    try:
+        whole = ConvexHull(vertices[np.unique(faces.ravel())]).volume
+    except QhullError:
+        return False
+    return bool(abs(whole - volume) <= CONVEX_TOLERANCE * whole)
