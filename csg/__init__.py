@@ -15,8 +15,8 @@ True
 """
 from .solid import (Complement, Difference, ExprSolid, Intersection, Solid, Transformed, Union,
                     rotation_matrix)
-from .primitives import (Box, ConvexPolyhedron, Cylinder, Ellipsoid, HalfSpace, Polyhedron,
-                         Sphere, Torus)
+from .primitives import (Box, Capsule, ConvexPolyhedron, Cylinder, Ellipsoid, HalfSpace,
+                         Polyhedron, Sphere, Torus)
 from .planar import Circle, Polygon, Rectangle, linear_extrude, rotate_extrude
 from .blends import Blobby, smooth_difference, smooth_intersection, smooth_union
 from .polytopes import NotAPolytope, hull, minkowski
@@ -27,8 +27,8 @@ from .scene import SceneError, load_json
 __all__ = [
     "Solid", "Union", "Intersection", "Difference", "Complement", "Transformed", "ExprSolid",
     "rotation_matrix",
-    "Sphere", "Box", "Cylinder", "Torus", "Ellipsoid", "HalfSpace", "ConvexPolyhedron",
-    "Polyhedron",
+    "Sphere", "Box", "Cylinder", "Torus", "Ellipsoid", "Capsule", "HalfSpace",
+    "ConvexPolyhedron", "Polyhedron",
     "Circle", "Rectangle", "Polygon", "linear_extrude", "rotate_extrude",
     "smooth_union", "smooth_intersection", "smooth_difference", "Blobby",
     "hull", "minkowski", "NotAPolytope",

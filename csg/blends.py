@@ -38,6 +38,17 @@ def _smin(a: Expr, b: Expr, k: float) -> Expr:
 class SmoothBoolean(Solid):
     """Smooth union, intersection or difference of two solids with a fillet ``radius``."""
 
+    scene_type = "smooth"
+
+    @classmethod
+    def from_scene(cls, read: Any, node: dict, path: str, depth: int) -> Solid:
+        """``kind`` (``"union"``, ``"intersection"``, ``"difference"``), ``radius``, ``children [2 NODEs]``."""
+        kids = read.kids(node, path, depth)
+        if len(kids) != 2:
+            raise ValueError("children: a smooth boolean takes exactly 2 children")
+        kind = read.choice(node, path, "kind", ("union", "intersection", "difference"))
+        return cls(kind, kids[0], kids[1], read.num(node, path, "radius"))
+
     def __init__(self, kind: str, a: Solid, b: Solid, radius: float):
         if kind not in ("union", "intersection", "difference"):
             raise ValueError(f"kind must be union, intersection or difference, got {kind!r}")
@@ -94,6 +105,14 @@ def smooth_difference(a: Solid, b: Solid, radius: float) -> Solid:
 class Blobby(Solid):
     """Stolte's blobby spheres: inside where ``sum_i exp(-|p - c_i|^2 / s_i^2)`` reaches
     ``threshold``; ``radius`` (one or per centre) is where a lone blob's surface lies."""
+
+    scene_type = "blobby"
+
+    @classmethod
+    def from_scene(cls, read: Any, node: dict, path: str, depth: int) -> Solid:
+        """``centers [[3]...]``, ``radius [...]``, ``threshold``."""
+        return cls(read.array(node, path, "centers", (None, 3)),
+                   read.array(node, path, "radius", (None,)), read.num(node, path, "threshold"))
 
     def __init__(self, centers: Sequence[Sequence[float]], radius: Any = 1.0,
                  threshold: float = 0.5):

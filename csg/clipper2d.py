@@ -95,11 +95,25 @@ def clip(subjects: list, clips: list, operation: str, fill: str = "PFT_NONZERO")
     if not subjects:
         return []                                 # nothing to unite, cut or keep
     clipper = pyclipper.Pyclipper()
-    clipper.AddPaths(subjects, pyclipper.PT_SUBJECT, True)
+    if not _add_paths(clipper, subjects, pyclipper.PT_SUBJECT):
+        return []                                 # every subject vanished on the grid
     if clips:
-        clipper.AddPaths(clips, pyclipper.PT_CLIP, True)
+        _add_paths(clipper, clips, pyclipper.PT_CLIP)    # none: nothing cuts or is kept
     fill_type = getattr(pyclipper, fill)
     return clipper.Execute(getattr(pyclipper, operation), fill_type, fill_type)
+
+
+def _add_paths(clipper: Any, paths: list, kind: Any) -> bool:
+    """Add closed paths to a Clipper; False when every one is degenerate on Clipper's
+    grid (a part smaller than 2^-16, its points truncated together). Clipper's C++
+    ``AddPaths`` then adds nothing and says so, as it does in OpenSCAD, which goes on
+    with what is left; pyclipper raises instead, and that is caught here."""
+    import pyclipper
+    try:
+        clipper.AddPaths(paths, kind, True)
+    except pyclipper.ClipperException:
+        return False
+    return True
 
 
 def _usable(paths: list) -> list:
@@ -160,7 +174,8 @@ def _tree_pieces(paths: list) -> list[tuple[np.ndarray, list[np.ndarray]]]:
     # GEB's shadows) are split into simple rings: the same region, and outlines whose
     # triangulation and crossing number need no special case
     clipper.StrictlySimple = True
-    clipper.AddPaths(paths, pyclipper.PT_SUBJECT, True)
+    if not _add_paths(clipper, paths, pyclipper.PT_SUBJECT):
+        return []
     tree = clipper.Execute2(pyclipper.CT_UNION, pyclipper.PFT_NONZERO, pyclipper.PFT_NONZERO)
     pieces = []
     stack = list(tree.Childs)

@@ -48,6 +48,13 @@ class Shape2D(Solid):
 class Circle(Shape2D):
     """Disc of radius ``r`` about the origin."""
 
+    scene_type = "circle"
+
+    @classmethod
+    def from_scene(cls, read: Any, node: dict, path: str, depth: int) -> Solid:
+        """``r``."""
+        return cls(read.num(node, path, "r"))
+
     curved = True
 
     def outlines(self) -> list[np.ndarray]:
@@ -76,6 +83,13 @@ class Circle(Shape2D):
 
 class Rectangle(Shape2D):
     """Rectangle of ``size``, from the origin corner or centred."""
+
+    scene_type = "rectangle"
+
+    @classmethod
+    def from_scene(cls, read: Any, node: dict, path: str, depth: int) -> Solid:
+        """``size [2]``, ``center`` (optional)."""
+        return cls(read.array(node, path, "size", (2,)), center=read.flag(node, path, "center"))
 
     def __init__(self, size: Sequence[float] = (1, 1), center: bool = False):
         s = np.asarray(size, dtype=np.float64).reshape(-1)
@@ -310,6 +324,14 @@ class Polygon(Shape2D):
     [(0, [1]), (2, [])]
     """
 
+    scene_type = "polygon"
+
+    @classmethod
+    def from_scene(cls, read: Any, node: dict, path: str, depth: int) -> Solid:
+        """``points [[2]...]``, ``paths [[ints]...]`` (optional)."""
+        return cls(read.array(node, path, "points", (None, 2)),
+                   read.index_lists(node, path, "paths"))
+
     def __init__(self, points: Any, paths: Optional[Sequence[Sequence[int]]] = None, *,
                  pieces: Optional[Sequence[tuple[int, Sequence[int]]]] = None):
         pts = np.asarray(points, dtype=np.float64)
@@ -423,6 +445,16 @@ def _radii(shape: Solid) -> tuple[float, float]:
 class LinearExtrude(Solid):
     """See :func:`linear_extrude`."""
 
+    scene_type = "linear_extrude"
+
+    @classmethod
+    def from_scene(cls, read: Any, node: dict, path: str, depth: int) -> Solid:
+        """``height``, ``twist``, ``scale [2]``, ``center``, ``child NODE``."""
+        return cls(read.child(node, path, depth), read.num(node, path, "height"),
+                   read.num(node, path, "twist", 0.0),
+                   read.array(node, path, "scale", (2,), [1.0, 1.0]),
+                   read.flag(node, path, "center"))
+
     def __init__(self, shape: Solid, height: float, twist: float = 0.0, scale: Any = 1.0,
                  center: bool = False):
         self._children = (_as_2d(shape),)
@@ -531,6 +563,14 @@ class LinearExtrude(Solid):
 
 class RotateExtrude(Solid):
     """See :func:`rotate_extrude`."""
+
+    scene_type = "rotate_extrude"
+
+    @classmethod
+    def from_scene(cls, read: Any, node: dict, path: str, depth: int) -> Solid:
+        """``angle``, ``sectors`` (optional int), ``child NODE``."""
+        return cls(read.child(node, path, depth), read.num(node, path, "angle", 360.0),
+                   read.integer(node, path, "sectors", None))
 
     def __init__(self, shape: Solid, angle: float = 360.0, sectors: Optional[int] = None):
         self._children = (_as_2d(shape),)

@@ -2,13 +2,17 @@
 
 A scene is ``{"implicitvox_scene": 1, "root": NODE}``; a node is an object
 with a ``"type"`` and its fields (numbers are JSON numbers, vectors are
-arrays; every field shown is required unless marked optional)::
+arrays; every field shown is required unless marked optional). The type names
+the solid class that reads the node (:data:`csg.solid.SCENE_TYPES`: each class
+registers its ``scene_type`` and reads its fields in ``from_scene``, so a new
+solid needs no line here); the built-in types::
 
     sphere            r, center (optional, [0, 0, 0])
     box               size [3], center (bool, optional)
     cylinder          h, r1, r2, center (optional)
     torus             R, r
     ellipsoid         radii [3], center (optional)
+    capsule           a [3], b [3], r
     halfspace         normal [3], offset
     convex_polyhedron normals [[3]...], offsets [...]   (or points [[3]...])
     polyhedron        vertices [[3]...], faces [[3 ints]...]
@@ -49,27 +53,15 @@ import numpy as np
 
 import implicitvox as iv
 
-from .blends import Blobby, SmoothBoolean
-from .planar import Circle, LinearExtrude, Polygon, Rectangle, RotateExtrude
-from .primitives import (Box, ConvexPolyhedron, Cylinder, Ellipsoid, HalfSpace, Polyhedron,
-                         Sphere, Torus)
-from .solid import (Complement, Difference, ExprSolid, Intersection, Solid, Transformed,
-                    Union)
+from . import blends, planar, primitives  # noqa: F401 - their solids register their types
+from .solid import SCENE_TYPES, Solid
 
-__all__ = ["to_json", "load_json", "to_dict", "from_dict", "SceneError", "LIMITS"]
+__all__ = ["to_json", "load_json", "to_dict", "from_dict", "SceneReader", "SceneError",
+           "LIMITS"]
 
 #: hostile-input limits
 LIMITS = {"text_bytes": 200 << 20, "depth": 100, "nodes": 100_000, "array": 5_000_000,
           "expr_chars": 1 << 20}
-
-
-#: the node types a scene may hold: the reader dispatches through this table only, so a
-#: "type" string never reaches any other attribute of the reader
-NODE_TYPES = frozenset({
-    "sphere", "box", "cylinder", "torus", "ellipsoid", "halfspace", "convex_polyhedron",
-    "polyhedron", "circle", "rectangle", "polygon", "union", "intersection", "difference",
-    "complement", "transform", "linear_extrude", "rotate_extrude", "smooth", "blobby",
-    "expression"})
 
 
 #: the longest string taken as a file name (Linux's PATH_MAX); a longer one that is not
@@ -139,12 +131,17 @@ def _no_constant(name: str):
 def from_dict(node: Any, path: str = "root") -> Solid:
     """The solid of a scene node (see the module docstring)."""
     try:
-        return _Reader().read(node, path, 0)
+        return SceneReader().read(node, path, 0)
     except RecursionError:      # a deep stack beneath us: refuse rather than crash
         raise SceneError(f"{path}: nested too deeply for the reader") from None
 
 
-class _Reader:
+class SceneReader:
+    """Reads scene nodes: each through the class its ``"type"`` names
+    (:data:`csg.solid.SCENE_TYPES`, :meth:`csg.solid.Solid.from_scene`: only
+    registered solid classes, so a ``"type"`` string never reaches anything else),
+    under :data:`LIMITS`; the field readers check a field and name it in their error."""
+
     def __init__(self) -> None:
         self.count = 0
 
@@ -157,12 +154,11 @@ class _Reader:
         if not isinstance(node, dict):
             raise SceneError(f"{path}: a node must be an object, got {type(node).__name__}")
         kind = node.get("type")
-        reader = getattr(self, f"_{kind}") if isinstance(kind, str) and kind in NODE_TYPES \
-            else None
-        if reader is None:
-            raise SceneError(f"{path}.type: unknown node type {kind!r}")
+        solid = SCENE_TYPES.get(kind) if isinstance(kind, str) else None
+        if solid is None:
+            raise SceneError(f"{path}.type: unknown node type {_short(kind)}")
         try:
-            return reader(node, path, depth)
+            return solid.from_scene(self, node, path, depth)
         except SceneError:
             raise
         except (ValueError, TypeError, ArithmeticError) as err:
@@ -213,104 +209,39 @@ class _Reader:
             raise SceneError(f"{path}.children: must be a non-empty list of nodes")
         return [self.read(c, f"{path}.children[{i}]", depth + 1) for i, c in enumerate(v)]
 
-    # node readers
-    def _sphere(self, n, p, d):
-        return Sphere(self.num(n, p, "r"), self.array(n, p, "center", (3,), [0, 0, 0]))
+    def integer(self, node, path, key, default=None):
+        v = node.get(key, default)
+        if v is None or (isinstance(v, int) and not isinstance(v, bool)):
+            return v
+        raise SceneError(f"{path}.{key}: must be an integer")
 
-    def _box(self, n, p, d):
-        return Box(self.array(n, p, "size", (3,)), center=self.flag(n, p, "center"))
+    def choice(self, node, path, key, options):
+        v = node.get(key)
+        if not isinstance(v, str) or v not in options:
+            raise SceneError(f"{path}.{key}: must be "
+                             + ", ".join(repr(o) for o in options[:-1])
+                             + f" or {options[-1]!r}")
+        return v
 
-    def _cylinder(self, n, p, d):
-        return Cylinder(h=self.num(n, p, "h"), r1=self.num(n, p, "r1"), r2=self.num(n, p, "r2"),
-                        center=self.flag(n, p, "center"))
+    def index_lists(self, node, path, key):
+        v = node.get(key)
+        if v is None:
+            return None
+        if not isinstance(v, list) or not all(
+                isinstance(q, list) and all(isinstance(i, int) and not isinstance(i, bool)
+                                            for i in q) for q in v):
+            raise SceneError(f"{path}.{key}: must be lists of integer indices")
+        if sum(len(q) for q in v) > LIMITS["array"]:
+            raise SceneError(f"{path}.{key}: more than {LIMITS['array']} indices")
+        return v
 
-    def _torus(self, n, p, d):
-        return Torus(self.num(n, p, "R"), self.num(n, p, "r"))
-
-    def _ellipsoid(self, n, p, d):
-        return Ellipsoid(self.array(n, p, "radii", (3,)), self.array(n, p, "center", (3,),
-                                                                     [0, 0, 0]))
-
-    def _halfspace(self, n, p, d):
-        return HalfSpace(self.array(n, p, "normal", (3,)), self.num(n, p, "offset"))
-
-    def _convex_polyhedron(self, n, p, d):
-        if "points" in n:
-            return ConvexPolyhedron(points=self.array(n, p, "points", (None, 3)))
-        return ConvexPolyhedron(planes=(self.array(n, p, "normals", (None, 3)),
-                                        self.array(n, p, "offsets", (None,))))
-
-    def _polyhedron(self, n, p, d):
-        return Polyhedron(self.array(n, p, "vertices", (None, 3)),
-                          self.array(n, p, "faces", (None, 3), integer=True))
-
-    def _circle(self, n, p, d):
-        return Circle(self.num(n, p, "r"))
-
-    def _rectangle(self, n, p, d):
-        return Rectangle(self.array(n, p, "size", (2,)), center=self.flag(n, p, "center"))
-
-    def _polygon(self, n, p, d):
-        paths = n.get("paths")
-        if paths is not None:
-            if not isinstance(paths, list) or not all(
-                    isinstance(q, list) and all(isinstance(i, int) and not isinstance(i, bool)
-                                                for i in q) for q in paths):
-                raise SceneError(f"{p}.paths: must be lists of integer indices")
-            if sum(len(q) for q in paths) > LIMITS["array"]:
-                raise SceneError(f"{p}.paths: more than {LIMITS['array']} indices")
-        return Polygon(self.array(n, p, "points", (None, 2)), paths)
-
-    def _union(self, n, p, d):
-        return Union(*self.kids(n, p, d))
-
-    def _intersection(self, n, p, d):
-        return Intersection(*self.kids(n, p, d))
-
-    def _difference(self, n, p, d):
-        return Difference(*self.kids(n, p, d))
-
-    def _complement(self, n, p, d):
-        return Complement(self.child(n, p, d))
-
-    def _transform(self, n, p, d):
-        return Transformed(self.child(n, p, d), self.array(n, p, "matrix", (4, 4)))
-
-    def _linear_extrude(self, n, p, d):
-        return LinearExtrude(self.child(n, p, d), self.num(n, p, "height"),
-                             self.num(n, p, "twist", 0.0), self.array(n, p, "scale", (2,),
-                                                                        [1.0, 1.0]),
-                             self.flag(n, p, "center"))
-
-    def _rotate_extrude(self, n, p, d):
-        sectors = n.get("sectors")
-        if sectors is not None and (isinstance(sectors, bool) or not isinstance(sectors, int)):
-            raise SceneError(f"{p}.sectors: must be an integer")
-        return RotateExtrude(self.child(n, p, d), self.num(n, p, "angle", 360.0), sectors)
-
-    def _smooth(self, n, p, d):
-        kids = self.kids(n, p, d)
-        if len(kids) != 2:
-            raise SceneError(f"{p}.children: a smooth boolean takes exactly 2 children")
-        kind = n.get("kind")
-        if not isinstance(kind, str):
-            raise SceneError(f"{p}.kind: must be 'union', 'intersection' or 'difference'")
-        return SmoothBoolean(kind, kids[0], kids[1], self.num(n, p, "radius"))
-
-    def _blobby(self, n, p, d):
-        return Blobby(self.array(n, p, "centers", (None, 3)),
-                      self.array(n, p, "radius", (None,)), self.num(n, p, "threshold"))
-
-    def _expression(self, n, p, d):
-        text = n.get("expr")
+    def expression(self, node, path, key):
+        text = node.get(key)
         if not isinstance(text, str):
-            raise SceneError(f"{p}.expr: must be a string")
+            raise SceneError(f"{path}.{key}: must be a string")
         if len(text) > LIMITS["expr_chars"]:
-            raise SceneError(f"{p}.expr: longer than {LIMITS['expr_chars']} characters")
-        bounds = n.get("bounds")
-        if bounds is not None:
-            bounds = self.array(n, p, "bounds", (2, 3))
-        return ExprSolid(parse_expression(text, f"{p}.expr"), bounds)
+            raise SceneError(f"{path}.{key}: longer than {LIMITS['expr_chars']} characters")
+        return parse_expression(text, f"{path}.{key}")
 
 
 _FUNCTIONS = {name: getattr(iv, name) for name in (

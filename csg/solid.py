@@ -46,6 +46,12 @@ SCENE_FORMAT = 1
 Bounds = Optional[tuple[tuple[float, float, float], tuple[float, float, float]]]
 
 
+#: scene node type -> the solid class that reads it (:meth:`Solid.from_scene`): each class
+#: names its type (``scene_type``) and registers itself when it is defined, so a new solid
+#: is read by :func:`csg.load_json` without a line elsewhere
+SCENE_TYPES: dict[str, type] = {}
+
+
 #: what builds a tree's :attr:`Solid.regularized_boundary` (the meshes and their
 #: booleans live above the solids: :mod:`csg.tree_mesh` registers it on import)
 _REGULARIZERS: list[Callable[["Solid"], Optional[Any]]] = []
@@ -72,6 +78,17 @@ class Solid:
     operation: Optional[str] = None
     exact = False
     needs_exact_test = False
+    #: the ``"type"`` of this class's JSON scene nodes (None: it is not read from scenes)
+    scene_type: Optional[str] = None
+
+    def __init_subclass__(cls, **kwargs: Any):
+        super().__init_subclass__(**kwargs)
+        kind = cls.__dict__.get("scene_type")
+        if kind is not None:
+            if kind in SCENE_TYPES and SCENE_TYPES[kind] is not cls:
+                raise TypeError(f"scene type {kind!r} is {SCENE_TYPES[kind].__name__}'s "
+                                f"already, not {cls.__name__}'s")
+            SCENE_TYPES[kind] = cls
 
     # -- what subclasses provide -------------------------------------------------
     @property
@@ -284,6 +301,13 @@ class Solid:
         return None if prim is None else prim.distance_function(norm)
 
     # -- scenes ------------------------------------------------------------------------
+    @classmethod
+    def from_scene(cls, read: Any, node: dict, path: str, depth: int) -> "Solid":
+        """The solid of a scene node of :attr:`scene_type`, its fields taken with the
+        reader ``read`` (:class:`csg.scene.SceneReader`: ``num``, ``flag``, ``array``,
+        ``child``, ``kids``, ``expression``, each checking and naming the field)."""
+        raise TypeError(f"{cls.__name__} is not read from scenes")
+
     def scene_node(self) -> dict:
         """This node of a JSON scene (:mod:`csg.scene`); each kind of solid writes its own."""
         raise TypeError(f"{type(self).__name__} has no JSON form")
@@ -399,6 +423,12 @@ class Union(_NaryBoolean):
 
     _symbol, _name = "|", "a union"
     operation = "union"
+    scene_type = "union"
+
+    @classmethod
+    def from_scene(cls, read: Any, node: dict, path: str, depth: int) -> "Solid":
+        """``children [NODE...]``."""
+        return cls(*read.kids(node, path, depth))
     _combine = staticmethod(iv.min)
 
     @property
@@ -415,6 +445,12 @@ class Intersection(_NaryBoolean):
 
     _symbol, _name = "&", "an intersection"
     operation = "intersection"
+    scene_type = "intersection"
+
+    @classmethod
+    def from_scene(cls, read: Any, node: dict, path: str, depth: int) -> "Solid":
+        """``children [NODE...]``."""
+        return cls(*read.kids(node, path, depth))
     _combine = staticmethod(iv.max)
 
     @property
@@ -432,6 +468,12 @@ class Difference(Solid):
     """The first solid minus the others: ``max(a, -b, ...)``."""
 
     operation = "difference"
+    scene_type = "difference"
+
+    @classmethod
+    def from_scene(cls, read: Any, node: dict, path: str, depth: int) -> "Solid":
+        """``children [NODE...]``: the first minus the rest."""
+        return cls(*read.kids(node, path, depth))
 
     def __init__(self, first: Solid, *others: Solid):
         self._children = (_check_solid(first, "-"),) + tuple(_check_solid(s, "-") for s in others)
@@ -460,6 +502,12 @@ class Complement(Solid):
     """Everything outside the solid: ``-f`` (unbounded)."""
 
     operation = "complement"
+    scene_type = "complement"
+
+    @classmethod
+    def from_scene(cls, read: Any, node: dict, path: str, depth: int) -> "Solid":
+        """``child NODE``."""
+        return cls(read.child(node, path, depth))
 
     def __init__(self, solid: Solid):
         self._children = (_check_solid(solid, "~"),)
@@ -486,6 +534,12 @@ class Transformed(Solid):
     """A solid moved by an affine map ``p -> A p + t`` (its function at the pre-image)."""
 
     operation = "transform"
+    scene_type = "transform"
+
+    @classmethod
+    def from_scene(cls, read: Any, node: dict, path: str, depth: int) -> "Solid":
+        """``matrix [[4] x 4], child NODE``."""
+        return cls(read.child(node, path, depth), read.array(node, path, "matrix", (4, 4)))
 
     def __init__(self, solid: Solid, matrix: Any):
         m = np.array(matrix, dtype=np.float64)
@@ -549,6 +603,16 @@ class Transformed(Solid):
 
 class ExprSolid(Solid):
     """A raw implicitvox expression as a solid (negative inside)."""
+
+    scene_type = "expression"
+
+    @classmethod
+    def from_scene(cls, read: Any, node: dict, path: str, depth: int) -> "Solid":
+        """``expr`` (implicitvox syntax, by a whitelist), ``bounds [2 x 3]`` (optional)."""
+        bounds = node.get("bounds")
+        if bounds is not None:
+            bounds = read.array(node, path, "bounds", (2, 3))
+        return cls(read.expression(node, path, "expr"), bounds)
 
     def __init__(self, expr: Any, bounds: Bounds = None):
         self._expr = iv.wrap(expr)

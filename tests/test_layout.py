@@ -48,7 +48,7 @@ IMPLICITVOX_ALL = [
 ]
 CSG_ALL = [
     "Solid", "Union", "Intersection", "Difference", "Complement", "Transformed", "ExprSolid",
-    "rotation_matrix", "Sphere", "Box", "Cylinder", "Torus", "Ellipsoid", "HalfSpace",
+    "rotation_matrix", "Sphere", "Box", "Cylinder", "Torus", "Ellipsoid", "Capsule", "HalfSpace",
     "ConvexPolyhedron", "Polyhedron", "Circle", "Rectangle", "Polygon", "linear_extrude",
     "rotate_extrude", "smooth_union", "smooth_intersection", "smooth_difference", "Blobby",
     "read_openscad", "OpenSCADError", "OpenSCADWarning", "load_json", "SceneError",

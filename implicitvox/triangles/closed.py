@@ -26,10 +26,22 @@ def mesh_volume(vertices: np.ndarray, faces: np.ndarray) -> float:
 
 def hull_mesh(points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """The convex hull of ``points`` (n, 3) as triangles ``(points, faces)``, each
-    oriented by the hull's outward normal (scipy's Qhull)."""
-    from scipy.spatial import ConvexHull
+    oriented by the hull's outward normal (scipy's Qhull).
+
+    Raises
+    ------
+    ValueError
+        The points span no volume (flat, or too small or too large for Qhull's
+        arithmetic), so their hull has no closed mesh.
+    """
+    from scipy.spatial import ConvexHull, QhullError
     points = np.asarray(points, dtype=np.float64)
-    hull = ConvexHull(points)
+    try:
+        hull = ConvexHull(points)
+    except (QhullError, ValueError) as err:
+        first = str(err).strip().splitlines()[0] if str(err).strip() else type(err).__name__
+        raise ValueError(f"the convex hull of {len(points)} points has no volume, or its "
+                         f"points are beyond Qhull's arithmetic ({first})") from None
     f = hull.simplices.copy()
     a, b, c = (points[f[:, k]] for k in range(3))
     inward = np.einsum("ij,ij->i", np.cross(b - a, c - a), hull.equations[:, :3]) < 0

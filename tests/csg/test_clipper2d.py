@@ -80,3 +80,17 @@ def test_true_circles_are_refused_or_faceted_with_a_warning():
     with pytest.raises(ValueError, match="join must be one of"):
         offset(Rectangle((1, 1)), 1.0, "bevel")
     assert math.isclose(CLIPPER_SCALE, 65536.0)
+
+
+def test_parts_that_vanish_on_clippers_grid_leave_nothing_not_an_exception():
+    """A part smaller than Clipper's 2^-16 truncates to a point: Clipper's own AddPaths
+    adds nothing (OpenSCAD goes on with the rest); pyclipper's exception is not let out."""
+    from csg.clipper2d import clip, to_clipper
+    tiny = to_clipper(np.array([[0, 0], [1e-20, 0], [1e-20, 1e-20]]))
+    square = to_clipper(np.array([[0, 0], [1, 0], [1, 1], [0, 1.0]]))
+    assert clip([tiny], [], "CT_UNION") == []
+    assert len(clip([square], [tiny], "CT_DIFFERENCE")) == 1            # nothing is cut
+    assert clip([square], [tiny], "CT_INTERSECTION") == []
+    solid = csg.read_openscad("linear_extrude(height = 1) square(size = [1e-20, 1]);\n"
+                          "cube(size = 1);")
+    assert solid.voxelize(8).count > 0
