@@ -52,6 +52,7 @@ csg.openscad_parser.OpenSCADError: <csg>:1:1: module 'roof' is not supported (su
 """
 from __future__ import annotations
 
+import functools
 import math
 import os
 import warnings
@@ -60,6 +61,7 @@ from typing import Any, Optional
 import numpy as np
 
 from . import facets as fx
+from .facet_modes import FACET_MODES, FacetMode
 from .clipper2d import NotFlat, offset as clipped_offset, region_pieces
 from .dxf import read_dxf
 from .prism import Prism, bound_functions
@@ -67,11 +69,11 @@ from .projection import NotAMesh, projection as project
 from .text import text_polygon
 from .heightmap import heightmap_mesh
 from .openscad_parser import Node, OpenSCADError, OpenSCADWarning, parse
-from .planar import Circle, LinearExtrude, Polygon, Rectangle, RotateExtrude
+from .planar import LinearExtrude, Polygon, Rectangle, RotateExtrude
 from implicitvox.triangles.inputs import MESH_SUFFIXES
 
-from .polytopes import NotAPolytope, convex_solid, hull, minkowski, vertices
-from .primitives import Box, Cylinder, Polyhedron, Sphere
+from .polytopes import NotAPolytope, hull, minkowski, vertices
+from .primitives import Box, Polyhedron
 from .solid import Difference, Intersection, Solid, Transformed, Union
 
 __all__ = ["read_openscad", "SUPPORTED", "UNSUPPORTED", "MAX_SLICES", "IMPORT_SUFFIXES"]
@@ -132,7 +134,7 @@ def read_openscad(path_or_text: Any, facets: str = "openscad", base: Any = None)
         root.modifiers = root.modifiers.replace("!", "")
     if base is None:
         base = os.path.dirname(os.path.abspath(source)) if source != "<csg>" else os.getcwd()
-    builder = _Builder(source, facets == "openscad", os.fspath(base))
+    builder = _Builder(source, FACET_MODES[facets], os.fspath(base))
     builder.build_from_leaves(nodes)
     built = [(n, s) for n, s in ((n, builder.build(n)) for n in nodes) if s is not None]
     if not built:
@@ -172,9 +174,19 @@ def _root_node(nodes: list[Node]) -> Optional[Node]:
 
 
 class _Builder:
-    def __init__(self, source: str, faceted: bool, base: str = "."):
-        self.source, self.faceted, self.base = source, faceted, base
+    """Builds the solids of a file's nodes, each once, in a facet mode
+    (:mod:`csg.facet_modes`: everything that differs between the modes)."""
+
+    def __init__(self, source: str, facets: FacetMode, base: str = "."):
+        self.source, self.facets, self.base = source, facets, base
         self._built: dict[int, tuple[Node, Optional[Solid]]] = {}
+
+    @functools.cached_property
+    def faceted_twin(self) -> "_Builder":
+        """The builder of the same file with OpenSCAD's facets (one, reused: each node
+        it builds is built once), for the operations only defined on them."""
+        openscad = FACET_MODES["openscad"]
+        return self if self.facets is openscad else _Builder(self.source, openscad, self.base)
 
     def error(self, node: Node, message: str) -> OpenSCADError:
         return OpenSCADError(message, node.line, node.column, self.source)
@@ -279,6 +291,10 @@ class _Builder:
 
     _union = _render = _color = _group
 
+    def group(self, node: Node) -> Optional[Solid]:
+        """The union of ``node``'s children's solids (None: no geometry)."""
+        return self._group(node)
+
     def _difference(self, node: Node) -> Optional[Solid]:
         if not node.children:
             return None
@@ -330,10 +346,7 @@ class _Builder:
         r = self._radius(node, "r", "d", 1.0, empty_ok=True)
         if not r > 0:
             return self.skip(node, f"radius {r} is not positive")
-        if not self.faceted:
-            return Sphere(r)
-        n = fx.fragments(r, *self.resolution(node))
-        return convex_solid(fx.sphere_points(r, n))
+        return self.facets.sphere(r, lambda: fx.fragments(r, *self.resolution(node)))
 
     def _radius(self, node: Node, rname: str, dname: str, default: float,
                 empty_ok: bool = False) -> float:
@@ -355,11 +368,8 @@ class _Builder:
         if r1 == 0 and r2 == 0:
             return self.skip(node, "both radii are 0")
         center = self.flag(node, "center")
-        if not self.faceted:
-            return Cylinder(h=h, r1=r1, r2=r2, center=center)
-        z1, z2 = (-h / 2, h / 2) if center else (0.0, h)
-        n = fx.fragments(max(r1, r2), *self.resolution(node))
-        return convex_solid(fx.cylinder_points(r1, r2, z1, z2, n))
+        return self.facets.cylinder(h, r1, r2, center,
+                                    lambda: fx.fragments(max(r1, r2), *self.resolution(node)))
 
     def _polyhedron(self, node: Node) -> Optional[Solid]:
         pts = self.arg(node, "points", None, 0)
@@ -433,9 +443,7 @@ class _Builder:
 
     def _circle(self, node: Node) -> Solid:
         r = self._radius(node, "r", "d", 1.0)
-        if not self.faceted:
-            return Circle(r)
-        return Polygon(fx.circle_points(r, fx.fragments(r, *self.resolution(node))))
+        return self.facets.circle(r, lambda: fx.fragments(r, *self.resolution(node)))
 
     def _square(self, node: Node) -> Solid:
         return Rectangle(self.vector(node, "size", 2, 1.0, 0), center=self.flag(node, "center"))
@@ -508,14 +516,13 @@ class _Builder:
         try:
             pieces = region_pieces(body)
         except NotFlat as err:
-            if not self.faceted:
-                return LinearExtrude(body, h, twist, scale, center)
-            raise self.error(node, f"linear_extrude: {err}") from None
+            return self.facets.unflat(self, node, err,
+                                      lambda: LinearExtrude(body, h, twist, scale, center))
         if not pieces:
             return self.skip(node, "its 2D children leave no area")
         if twist == 0 and scale[0] == scale[1] == 1:
             return Prism(pieces, h, center)
-        if not _holds_text(node) and (not self.faceted or straight):
+        if self.facets.extrusion(straight, _holds_text(node)):
             return LinearExtrude(body, h, twist, scale, center)
         if straight:
             slices = 1.0
@@ -541,8 +548,10 @@ class _Builder:
         angle = self.number(node, "angle", 360.0)
         if angle == 0:
             return self.skip(node, "angle 0 sweeps no volume")
-        if not self.faceted:
-            return RotateExtrude(body, angle)
+        return self.facets.sweep(self, node, body, angle)
+
+    def faceted_sweep(self, node: Node, body: Solid, angle: float) -> Optional[Solid]:
+        """``rotate_extrude`` as OpenSCAD 2021.01 sweeps it: its sectors, as a mesh."""
         b = body.bounds
         max_x = max(abs(b[0][0]), abs(b[1][0])) if b is not None else 1.0
         n = max(int(fx.fragments(max_x, *self.resolution(node)) * abs(angle) / 360), 1)
@@ -569,12 +578,8 @@ class _Builder:
             for kid in kids:
                 vertices(kid)
         except NotAPolytope as err:
-            if self.faceted or not err.curved:
-                raise
-            warnings.warn(f"{self.source}:{node.line}:{node.column}: {what}: its curved "
-                          "children are taken as OpenSCAD's facets ($fn, $fa, $fs), as "
-                          "OpenSCAD does", OpenSCADWarning, stacklevel=5)
-            kids = _Builder(self.source, True, self.base).children(node)
+            kids = self.facets.facet(self, node, what, err,
+                                     lambda faceted: faceted.children(node))
         if kids and any(k.dim != kids[0].dim for k in kids):
             for child, kid in zip(node.children, kids):
                 if kid.dim != kids[0].dim:
@@ -612,14 +617,10 @@ class _Builder:
         n = fx.fragments(abs(value), fn, fs, fa)
         try:
             region = clipped_offset(body, value, join, n)
-        except NotFlat:
-            if self.faceted:
-                raise
-            warnings.warn(f"{self.source}:{node.line}:{node.column}: offset: its circles are "
-                          "taken as OpenSCAD's polygons ($fn, $fa, $fs), as OpenSCAD does",
-                          OpenSCADWarning, stacklevel=5)
-            body = _Builder(self.source, True, self.base)._group(node)
-            region = clipped_offset(body, value, join, n)
+        except NotFlat as err:
+            region = self.facets.facet(
+                self, node, "offset", err,
+                lambda faceted: clipped_offset(faceted.group(node), value, join, n))
         if region is None:
             return self.skip(node, f"the offset by {value:g} leaves nothing")
         return region
@@ -638,12 +639,8 @@ class _Builder:
         try:
             region = project(body, cut=cut)
         except NotAMesh as err:
-            if self.faceted or not err.curved:
-                raise
-            warnings.warn(f"{self.source}:{node.line}:{node.column}: projection: its curved "
-                          "children are taken as OpenSCAD's facets ($fn, $fa, $fs), as "
-                          "OpenSCAD does", OpenSCADWarning, stacklevel=5)
-            region = project(_Builder(self.source, True, self.base)._group(node), cut=cut)
+            region = self.facets.facet(self, node, "projection", err,
+                                       lambda faceted: project(faceted.group(node), cut=cut))
         if region is None:
             return self.skip(node, "the projection is empty" + (" (nothing meets z = 0)"
                                                                  if cut else ""))
@@ -659,7 +656,7 @@ class _Builder:
         dim = body.dim
         newsize = self.vector(node, "newsize", 3, 0.0, 0)
         auto = self.vector(node, "auto", 3, 0.0, 1) != 0
-        faceted = body if self.faceted else _Builder(self.source, True, self.base)._group(node)
+        faceted = self.facets.faceted_body(self, node, body)
         try:
             points = vertices(faceted)
         except NotAPolytope as err:

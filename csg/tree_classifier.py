@@ -15,7 +15,7 @@ leaf classifies boxes as EMPTY, FULL or AMBIGUOUS:
   distance (Varadhan §5.1, :mod:`implicitvox.linf`): AMBIGUOUS iff the
   surface meets the box (up to rounding at exact ties);
 * a straight prism (:class:`csg.prism.Prism`, OpenSCAD's extrusion of a 2D
-  region) exactly, by its outlines' edges (:class:`csg.prism.PrismClassifier`)
+  region) exactly, by its outlines' edges (:class:`implicitvox.triangles.prism_classifier.PrismClassifier`)
   or its mesh;
 * a function by its interval enclosure (sound; AMBIGUOUS may be a near miss).
 
@@ -46,7 +46,7 @@ import implicitvox as iv
 from implicitvox import batches
 from implicitvox.expr.shape import AMBIGUOUS, EMPTY, FULL, Octants
 from implicitvox.octree.morton import CORNERS
-from .mesh_classifier import MeshClassifier, forget_decided
+from implicitvox.triangles.mesh_classifier import MeshClassifier, forget_decided
 
 __all__ = ["plan", "exact_classifier", "world_primitive", "similarity_scale", "MeshClassifier",
            "SETTLE_DEPTH", "SUPPORT_PAD"]

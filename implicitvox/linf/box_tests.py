@@ -31,7 +31,13 @@ def classify_by_distance(distance: Callable, lo: np.ndarray, hi: np.ndarray,
     centre = 0.5 * (lo + hi)
     half_width = 0.5 * (hi - lo)
     half = np.where(half_width > 0, half_width, np.finfo(np.float64).tiny)
-    d = distance(centre, half)
+    # a flat or tiny box's weights divide to +-inf (or a sphere's centre meets a zero
+    # weight): the weighted distance of a box farther than any float is that infinity,
+    # the right value; where infinities meet (inf - inf) the distance is NaN, which
+    # compares false both ways below and leaves the box AMBIGUOUS (subdivided, never
+    # wrongly decided). Neither is a fault, so numpy says nothing of them here
+    with np.errstate(over="ignore", divide="ignore", invalid="ignore"):
+        d = distance(centre, half)
     # A tie (the surface touching the closed box) computes to 1 only up to the
     # rounding of the centre and of the distance: a box touching a face on a lattice
     # plane could come out EMPTY while its parent, touching the same face, came out

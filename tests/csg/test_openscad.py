@@ -268,3 +268,18 @@ def test_openscads_facets_are_the_default():
     circle = np.array(read_openscad(text, facets="true").bounds)
     assert np.allclose(hexagon, [[-1, -np.sqrt(3) / 2, 0], [1, np.sqrt(3) / 2, 1]])
     assert np.allclose(circle, [[-1, -1, 0], [1, 1, 1]])
+
+
+@pytest.mark.parametrize("model, facets", [("bracket", "openscad"), ("bracket", "true"),
+                                           ("knob", "openscad"), ("pyramid", "true"),
+                                           ("primitives", "true"), ("imported", "true")])
+def test_an_ordinary_run_prints_no_numpy_warning(model, facets):
+    """The max-norm box tests divide by tiny half-widths (to an infinity, the right
+    distance) and meet inf - inf (NaN: the box stays AMBIGUOUS): no RuntimeWarning
+    reaches the user (they were printed once per worker, into the progress bar)."""
+    import warnings
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", UserWarning)
+        solid = read_openscad(FIXTURES / f"{model}.csg", facets=facets)
+        warnings.simplefilter("error", RuntimeWarning)
+        solid.voxelize(48, workers=1)

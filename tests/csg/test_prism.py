@@ -7,7 +7,8 @@ import pytest
 import csg
 from csg.tree_classifier import MeshClassifier
 from csg.clipper2d import region_pieces
-from csg.prism import Prism, axis_permutation
+from csg.prism import Prism
+from implicitvox.triangles.prism_classifier import axis_permutation
 
 
 def _star(rng, n, r0, r1, centre):

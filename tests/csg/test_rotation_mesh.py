@@ -11,7 +11,7 @@ import pytest
 import implicitvox as ivx
 from csg import Polyhedron, read_openscad
 from csg.facets import rotation_mesh_outlines
-from csg.mesh_classifier import edges_shared
+from implicitvox.triangles.mesh_classifier import edges_shared
 
 FIXTURES = Path(__file__).resolve().parents[1] / "openscad"
 

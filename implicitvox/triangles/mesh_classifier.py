@@ -39,11 +39,11 @@ from typing import Optional
 
 import numpy as np
 
-from implicitvox.expr.shape import AMBIGUOUS, EMPTY, FULL, Octants
-from implicitvox.triangles.crossings import RayWinding
-from implicitvox.triangles.pairs import sorted_unique
-from implicitvox.triangles.ranges import buckets, expand_boxes, gather, grid_cells
-from implicitvox.triangles.tribox import Triangles
+from ..expr.shape import AMBIGUOUS, EMPTY, FULL, Octants
+from .crossings import RayWinding
+from .pairs import sorted_unique
+from .ranges import buckets, expand_boxes, gather, grid_cells
+from .tribox import Triangles
 
 __all__ = ["MeshClassifier", "BoxMemory", "edges_shared", "forget_decided", "LISTED", "OFF"]
 

@@ -1,4 +1,4 @@
-"""The mesh leaf's memory of the octants (csg.mesh_classifier) changes no state.
+"""The mesh leaf's memory of the octants (implicitvox.triangles.mesh_classifier) changes no state.
 
 Boxes whose parents the leaf remembered are tested against the parents'
 triangles, or, below a box met by one triangle of a closed mesh, by that
@@ -15,7 +15,7 @@ import pyvista as pv
 
 import implicitvox as ivx
 from csg import Box, Polyhedron, Sphere
-from csg.mesh_classifier import OFF, BoxMemory, MeshClassifier, edges_shared, forget_decided
+from implicitvox.triangles.mesh_classifier import OFF, BoxMemory, MeshClassifier, edges_shared, forget_decided
 from implicitvox.expr.shape import Octants, takes_octants
 from implicitvox.octree.grid import grid_of
 from implicitvox.octree.subdivide import subdivide
