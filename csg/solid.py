@@ -33,6 +33,7 @@ import numpy as np
 
 import implicitvox as iv
 from implicitvox import Expr, validate, x, y, z
+from implicitvox.voxelizers.mesh import nearest_triangle_normals
 
 from .protocol import NotAMesh, NotAPolytope, NotFlat
 from .tree_classifier import exact_classifier, plan, world_primitive
@@ -55,6 +56,17 @@ SCENE_TYPES: dict[str, type] = {}
 #: what builds a tree's :attr:`Solid.regularized_boundary` (the meshes and their
 #: booleans live above the solids: :mod:`csg.tree_mesh` registers it on import)
 _REGULARIZERS: list[Callable[["Solid"], Optional[Any]]] = []
+
+
+#: what gives a tree's facets (its leaves' triangles, moved) for its normals: the meshes
+#: live above the solids, :mod:`csg.tree_mesh` registers it on import
+_FACETS: list[Callable[["Solid"], Optional[np.ndarray]]] = []
+
+
+def register_facets(build: Callable[["Solid"], Optional[np.ndarray]]) -> None:
+    """Make ``build(solid)`` (its leaves' triangles ``(t, 3, 3)``, or None) what
+    :attr:`Solid.surface_normals` falls back on."""
+    _FACETS.append(build)
 
 
 def register_regularizer(build: Callable[["Solid"], Optional[Any]]) -> None:
@@ -241,6 +253,23 @@ class Solid:
         return True
 
     # -- voxelization --------------------------------------------------------------
+    @property
+    def surface_normals(self) -> Optional[Callable[[np.ndarray], np.ndarray]]:
+        """Normals from the solid's own facets where its function only bounds it
+        (:attr:`expression_is_exact` False: OpenSCAD's facets, imported meshes): the
+        normal of the regularized boundary's triangle nearest to each point
+        (:attr:`regularized_boundary`; where the tree has none, as when a leaf's mesh is
+        not manifold, the nearest of its leaves' triangles); None where the function is
+        exact (its gradient is the normal) or no leaf has a mesh."""
+        if self.expression_is_exact:
+            return None
+        boundary = self.regularized_boundary
+        triangles = boundary.tris.v if boundary is not None else \
+            (_FACETS[-1](self) if _FACETS else None)
+        if triangles is None or not len(triangles):
+            return None
+        return lambda points: nearest_triangle_normals(triangles, np.asarray(points, float))
+
     @property
     def classify_boxes(self) -> Optional[Callable[[np.ndarray, np.ndarray], np.ndarray]]:
         """Exact box test (:mod:`csg.tree_classifier`) if a leaf has one, else None."""

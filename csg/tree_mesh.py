@@ -24,13 +24,15 @@ Examples
 """
 from __future__ import annotations
 
+from typing import Optional
+
 import numpy as np
 
 from implicitvox.triangles.closed import mesh_volume
 
 from .protocol import NotAMesh, fold
 from .tree_classifier import MeshClassifier
-from .solid import Solid, register_regularizer
+from .solid import Solid, register_facets, register_regularizer
 
 __all__ = ["tree_mesh", "leaf_mesh", "mesh_volume", "NotAMesh", "regularized_classifier"]
 
@@ -109,4 +111,21 @@ def regularized_classifier(solid: Solid):
     return MeshClassifier(v, f) if len(f) else None
 
 
+def leaf_triangles(solid: Solid) -> Optional[np.ndarray]:
+    """Every leaf's triangles ``(t, 3, 3)``, moved, through every boolean (no boolean is
+    computed: for the normals of facets near the surface); leaves without a mesh are
+    left out; None when none has one."""
+    def leaf(node: Solid, matrix: np.ndarray) -> list:
+        try:
+            v, f = leaf_mesh(node, matrix)
+        except (NotAMesh, ValueError):
+            return []
+        return [v[f]]
+
+    parts = fold(solid, leaf, lambda operation, kids: [p for kid in kids for p in kid],
+                 booleans=("union", "intersection", "difference", "complement"))
+    return np.concatenate(parts) if parts else None
+
+
 register_regularizer(regularized_classifier)
+register_facets(leaf_triangles)

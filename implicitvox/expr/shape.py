@@ -27,6 +27,10 @@ A shape has
   only bounds the solid (zero inside a polyhedron's bounding box, say) and
   the exact test alone knows the surface: such a shape can be voxelized,
   not meshed (:func:`implicitvox.mesh` needs point values).
+* ``surface_normals`` (optional) - None, or a function from points ``(n, 3)`` to
+  unit normals ``(n, 3)`` of the surface near them, for a shape whose ``expr``
+  only bounds it (its gradient says nothing of the surface: OpenSCAD's facets);
+  stored and rendered normals then come from it, never from the bound.
 
 A bare expression is a shape without bounds or exact test.
 """
@@ -41,7 +45,8 @@ import numpy as np
 from .nodes import Expr
 
 __all__ = ["Shape", "EMPTY", "FULL", "AMBIGUOUS", "as_shape", "ExprShape", "exact_classifier",
-           "voxel_classifier", "expression_is_exact", "Octants", "takes_octants"]
+           "voxel_classifier", "expression_is_exact", "surface_normals", "Octants",
+           "takes_octants"]
 
 #: octant states
 EMPTY, FULL, AMBIGUOUS = 0, 1, 2
@@ -123,6 +128,13 @@ def voxel_classifier(shape: Any) -> Optional[Callable[[np.ndarray, np.ndarray], 
     ``classify_boxes``), if it has one."""
     test = getattr(shape, "classify_voxels", None)
     return test if callable(test) else exact_classifier(shape)
+
+
+def surface_normals(shape: Any) -> Optional[Callable[[np.ndarray], np.ndarray]]:
+    """The shape's own normals (see the module docstring), or None: the gradient of
+    its ``expr`` then gives them."""
+    own = getattr(shape, "surface_normals", None)
+    return own if callable(own) else None
 
 
 def expression_is_exact(shape: Any) -> bool:

@@ -20,7 +20,7 @@ import numpy as np
 from .. import batches
 from ..version import __version__
 from ..eval.function import Function
-from ..expr.shape import as_shape, exact_classifier, voxel_classifier
+from ..expr.shape import as_shape, exact_classifier, surface_normals, voxel_classifier
 from ..meshing.mesher import REFINE, mesh, mesh_grid
 from ..octree.morton import MAX_BITS
 from ..octree.grid import Grid, grid_of
@@ -107,7 +107,12 @@ class ImplicitSource:
                          refine=levels, prune=self.options.prune)
 
     def normals_at(self, points: np.ndarray) -> np.ndarray:
-        """Unit gradients of the shape's function at ``points`` (n, 3)."""
+        """Unit normals at ``points`` (n, 3): the shape's own where its function only
+        bounds it (:func:`implicitvox.expr.shape.surface_normals`), else the unit
+        gradients of its function."""
+        own = surface_normals(self.shape)
+        if own is not None and len(points):
+            return np.asarray(own(points), dtype=np.float32)
         _, g = self.func.gradient(points[:, 0], points[:, 1], points[:, 2])
         return unit_vectors(g)
 
@@ -235,6 +240,9 @@ def _run(source: ImplicitSource, grid: Grid, run: Run, start, interior_before) -
     t1 = time.perf_counter()
     _warn_if_useless(count, grid)
     tree = Octree.from_codes(result.codes, grid.depth, payload) if split is None else split.tree
+    if options.normals and surface_normals(shape) is not None and count:
+        # the function only bounds the solid: its gradient says nothing of the surface
+        tree.payload["normals"] = source.normals_at(grid.centers(tree.coords()))
     interior = dict(interior_before or {})
     for level, coords in result.interior.items():
         interior[level] = np.concatenate([interior[level], coords]) if level in interior else coords

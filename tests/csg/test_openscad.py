@@ -283,3 +283,27 @@ def test_an_ordinary_run_prints_no_numpy_warning(model, facets):
         solid = read_openscad(FIXTURES / f"{model}.csg", facets=facets)
         warnings.simplefilter("error", RuntimeWarning)
         solid.voxelize(48, workers=1)
+
+
+def test_faceted_solids_take_their_normals_from_their_facets():
+    """OpenSCAD's facets are bounded by a box function whose gradient says nothing of
+    the surface (70% of the knob's voxels got zero normals and rendered black): the
+    normals come from the nearest facet instead, stored and rendered alike."""
+    import warnings
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", UserWarning)
+        knob = read_openscad(FIXTURES / "knob.csg")
+        vox = knob.voxelize(48, workers=1, normals=True)
+    assert not knob.expression_is_exact
+    shading = vox.source.normals_at(vox.centers())
+    assert np.allclose(np.linalg.norm(shading, axis=1), 1, atol=1e-6)
+    assert np.array_equal(shading, vox.normals)
+    # a pyramid of four sloped faces (a polyhedron): every voxel's normal is a face's
+    pyramid = read_openscad("polyhedron(points = [[0, 0, 0], [10, 0, 0], [10, 10, 0], "
+                            "[0, 10, 0], [5, 5, 6]], faces = [[0, 1, 4], [1, 2, 4], "
+                            "[2, 3, 4], [3, 0, 4], [1, 0, 3], [2, 1, 3]]);")
+    normals = pyramid.voxelize(32, workers=1).source.normals_at(
+        pyramid.voxelize(32, workers=1).centers())
+    faces = np.array([[0, -6, 5], [6, 0, 5], [0, 6, 5], [-6, 0, 5], [0, 0, -1]], float)
+    faces /= np.linalg.norm(faces, axis=1, keepdims=True)
+    assert np.abs(normals @ faces.T).max(axis=1).min() > 1 - 1e-6
