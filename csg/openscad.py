@@ -295,19 +295,35 @@ class _Builder:
         """The union of ``node``'s children's solids (None: no geometry)."""
         return self._group(node)
 
+    def _one_dimension(self, node: Node, built: list) -> list:
+        """The operands of a boolean ``(child node, solid)`` of the first one's dimension:
+        OpenSCAD ignores the others, with a warning ("mixing 2D and 3D objects is not
+        supported"), and so does this: a circle is no drill through a cube."""
+        if not built:
+            return built
+        dim = built[0][1].dim
+        for child, solid in built[1:]:
+            if solid.dim != dim:
+                self.skip(child, f"a {solid.dim}D child of a {dim}D {node.name} (OpenSCAD "
+                                 "does not mix 2D and 3D objects)")
+        return [(child, solid) for child, solid in built if solid.dim == dim]
+
     def _difference(self, node: Node) -> Optional[Solid]:
         if not node.children:
             return None
         first = self.build(node.children[0])
         if first is None:
             return None
-        rest = [s for s in (self.build(c) for c in node.children[1:]) if s is not None]
+        built = [(c, s) for c, s in ((c, self.build(c)) for c in node.children[1:])
+                 if s is not None]
+        rest = [s for _, s in self._one_dimension(node, [(node.children[0], first)] + built)][1:]
         return Difference(first, *rest) if rest else first
 
     def _intersection(self, node: Node) -> Optional[Solid]:
-        kids = self.children(node)
-        if not kids or len(kids) < len(node.children):
+        built = [(c, self.build(c)) for c in node.children]
+        if not built or any(s is None for _, s in built):
             return None                       # an empty operand empties the intersection
+        kids = [s for _, s in self._one_dimension(node, built)]
         return kids[0] if len(kids) == 1 else Intersection(*kids)
 
     def _multmatrix(self, node: Node) -> Optional[Solid]:
@@ -376,6 +392,8 @@ class _Builder:
         faces = self.arg(node, "faces", None, 1)
         if faces is None:
             faces = self.arg(node, "triangles", None)
+        if pts is None:
+            return self.skip(node, "its points are undef")
         try:
             v = np.array(pts, dtype=np.float64)
         except (TypeError, ValueError):
@@ -441,8 +459,10 @@ class _Builder:
         return Polyhedron(*heightmap_mesh(path, center=self.flag(node, "center"),
                                           invert=self.flag(node, "invert")))
 
-    def _circle(self, node: Node) -> Solid:
-        r = self._radius(node, "r", "d", 1.0)
+    def _circle(self, node: Node) -> Optional[Solid]:
+        r = self._radius(node, "r", "d", 1.0, empty_ok=True)
+        if not r > 0:
+            return self.skip(node, f"radius {r:g} is not positive")
         return self.facets.circle(r, lambda: fx.fragments(r, *self.resolution(node)))
 
     def _square(self, node: Node) -> Solid:
@@ -504,7 +524,9 @@ class _Builder:
         body = self._section(node)
         if body is None:
             return None
-        h = self.number(node, "height", 100.0, 0, positive=True)
+        h = self.number(node, "height", 100.0, 0)
+        if not h > 0:
+            return self.skip(node, f"height {h:g} is not positive")
         twist = self.number(node, "twist", 0.0)
         scale = self.vector(node, "scale", 2, 1.0)
         center = self.flag(node, "center")
@@ -574,6 +596,17 @@ class _Builder:
         warning): the hull or sum of curved solids is no polytope, and this is the
         solid OpenSCAD itself makes."""
         kids = self.children(node)
+        built = [(c, self.build(c)) for c in node.children]
+        empty = []
+        for child, kid in built:
+            try:
+                if kid is not None:
+                    vertices(kid)
+            except NotAPolytope as err:
+                if err.empty:            # an empty boolean: OpenSCAD's is no geometry
+                    self.skip(child, f"{err} (its {what} takes the others)")
+                    empty.append(id(kid))
+        kids = [k for k in kids if id(k) not in empty]
         try:
             for kid in kids:
                 vertices(kid)
@@ -671,7 +704,8 @@ class _Builder:
                     raise self.error(node, "resize: a flat child cannot be resized across "
                                            "its plane")
                 scale[axis] = newsize[axis] / size[axis]
-        automatic = scale[:dim].max()
+        # OpenSCAD's autoscale: the factor of the axis given the largest new size
+        automatic = scale[int(np.argmax(newsize[:dim]))]
         for axis in range(dim):
             if auto[axis] and newsize[axis] <= 0:
                 scale[axis] = automatic

@@ -111,7 +111,8 @@ def _boolean_vertices(solid: Solid) -> np.ndarray:
         except NotFlat as err:
             raise NotAPolytope(str(err), curved=True) from None
         if not paths:
-            raise NotAPolytope(f"the {type(solid).__name__.lower()} is empty: no vertices")
+            raise NotAPolytope(f"the {type(solid).__name__.lower()} is empty: no vertices",
+                               empty=True)
         flat = np.concatenate([np.asarray(q, dtype=np.float64) for q in paths]) / CLIPPER_SCALE
         return np.column_stack([flat, np.zeros(len(flat))])
     try:
@@ -119,7 +120,8 @@ def _boolean_vertices(solid: Solid) -> np.ndarray:
     except NotAMesh as err:
         raise NotAPolytope(str(err), curved=err.curved) from None
     if not len(f):
-        raise NotAPolytope(f"the {type(solid).__name__.lower()} is empty: no vertices")
+        raise NotAPolytope(f"the {type(solid).__name__.lower()} is empty: no vertices",
+                               empty=True)
     return v[np.unique(f.ravel())]
 
 

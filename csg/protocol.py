@@ -75,11 +75,12 @@ OPTIONAL = {"world_linf": ("matrix",), "exact_leaf": ("matrix",),
 
 class NotAPolytope(ValueError):
     """A solid whose hull or Minkowski sum is not a polytope here (a curved leaf:
-    ``curved`` is set), or that has no vertex set."""
+    ``curved`` is set), or that has no vertex set (an empty boolean: ``empty`` is set)."""
 
-    def __init__(self, message: str, curved: bool = False):
+    def __init__(self, message: str, curved: bool = False, empty: bool = False):
         super().__init__(message)
         self.curved = curved
+        self.empty = empty
 
 
 class NotAMesh(ValueError):

@@ -29,6 +29,11 @@ BOUNDS = ((-1.5,) * 3, (1.5,) * 3)
      "polyhedron: faces[0] [0.0, 1.0, 5.0] does not list 3 or more indices"),
     ("polyhedron(points = [[0, 0, 0], [1, 0, 0], [0, 1, 0]], faces = [[0, 1]]);",
      "polyhedron: faces[0] [0.0, 1.0] does not list 3 or more indices"),
+    # issue 51: the same rule for every primitive and extrusion
+    ("linear_extrude(height = 0) square(size = [1, 1]);",
+     "linear_extrude: height 0 is not positive"),
+    ("polyhedron(points = undef, faces = [[0, 1, 2]], convexity = 1);",
+     "polyhedron: its points are undef"),
 ])
 def test_skipped_with_a_warning_and_the_rest_read(degenerate, says):
     text = f"group() {{\n  {REST}\n  {degenerate}\n}}\n"
@@ -100,3 +105,57 @@ def test_import_of_a_missing_or_unread_file(tmp_path):
     with pytest.warns(csg.OpenSCADWarning, match=r"<csg>:1:19: import: cannot open .*gone.dxf"):
         assert csg.read_openscad('linear_extrude(1) import(file = "gone.dxf"); cube(1);',
                                  base=tmp_path, facets="true").bounds == ((0.0, 0.0, 0.0), (1.0, 1.0, 1.0))
+
+
+
+def _read(text: str):
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", csg.OpenSCADWarning)
+        return csg.read_openscad(text)
+
+
+def test_a_2d_child_of_a_3d_boolean_is_ignored_with_a_warning():
+    """OpenSCAD does not mix 2D and 3D operands: the circle bores no endless hole."""
+    text = "difference() {\n  cube(size = 10);\n  circle(r = 6);\n}\n"
+    with pytest.warns(csg.OpenSCADWarning, match=r"<csg>:3:3: circle: a 2D child of a 3D "
+                                                 r"difference"):
+        solid = csg.read_openscad(text)
+    cube = _read("cube(size = 10);")
+    assert np.array_equal(solid.voxelize(24).coords(), cube.voxelize(24).coords())
+
+
+def test_an_intersection_with_an_empty_extrusion_is_empty():
+    with pytest.raises(csg.OpenSCADError, match="holds no geometry"):
+        _read("intersection() { cube(size = 10); linear_extrude(height = 0) "
+              "square(size = 5); }")
+
+
+def test_a_hull_skips_an_empty_child_and_hulls_the_rest():
+    text = ("hull() {\n  intersection() { cube(size = 1); multmatrix([[1, 0, 0, 5], [0, 1, 0, 0], "
+            "[0, 0, 1, 0], [0, 0, 0, 1]]) cube(size = 1); }\n"
+            "  multmatrix([[1, 0, 0, 2], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]]) "
+            "cube(size = 1);\n  cube(size = 1);\n}\n")
+    with pytest.warns(csg.OpenSCADWarning, match=r"<csg>:2:3: intersection: the intersection "
+                                                 r"is empty"):
+        solid = csg.read_openscad(text)
+    assert np.allclose(solid.bounds, ((0, 0, 0), (3, 1, 1)), atol=1e-9)
+
+
+@pytest.mark.parametrize("newsize, auto, size", [
+    ("[6, 0, 0]", "[1, 1, 1]", (6, 6, 6)),        # shrinking: auto axes take x's factor
+    ("[18, 0, 0]", "[1, 1, 1]", (18, 18, 18)),    # growing
+    ("[6, 0, 0]", "[0, 0, 0]", (6, 9, 9)),        # no auto: the others stay
+    ("[6, 27, 0]", "[1, 1, 1]", (6, 27, 27)),     # auto takes the largest new size's factor
+])
+def test_resize_autoscales_as_openscad_does(newsize, auto, size):
+    solid = _read(f"resize(newsize = {newsize}, auto = {auto}) cube(size = 9);")
+    lo, hi = np.asarray(solid.bounds)
+    assert np.allclose(hi - lo, size, atol=1e-6)
+
+
+def test_a_circle_of_radius_0_is_skipped_and_its_extrusion_with_it():
+    text = "group() {\n  sphere(r = 1);\n  linear_extrude(height = 1) circle(r = 0);\n}\n"
+    with pytest.warns(csg.OpenSCADWarning, match=r"<csg>:3:30: circle: radius 0 is not "
+                                                 r"positive; skipped, as OpenSCAD does"):
+        solid = csg.read_openscad(text, facets="true")
+    assert np.allclose(solid.bounds, ((-1,) * 3, (1,) * 3))
