@@ -595,30 +595,37 @@ class _Builder:
         ``facets="true"``, curved children are taken as OpenSCAD's facets (with a
         warning): the hull or sum of curved solids is no polytope, and this is the
         solid OpenSCAD itself makes."""
-        kids = self.children(node)
-        built = [(c, self.build(c)) for c in node.children]
-        empty = []
-        for child, kid in built:
+        pairs, failure = self._polytope_operands(node, what)
+        if failure is not None:
+            pairs = self.facets.facet(self, node, what, failure,
+                                      lambda faceted: faceted._polytope_operands(node, what)[0])
+        if pairs and any(kid.dim != pairs[0][1].dim for _, kid in pairs):
+            dim = pairs[0][1].dim
+            for child, kid in pairs:
+                if kid.dim != dim:
+                    self.skip(child, f"a {kid.dim}D child of a {dim}D {what}")
+            pairs = [(child, kid) for child, kid in pairs if kid.dim == dim]
+        return [kid for _, kid in pairs]
+
+    def _polytope_operands(self, node: Node, what: str
+                           ) -> tuple[list[tuple[Node, Solid]], Optional[NotAPolytope]]:
+        """The children ``(node, solid)`` with geometry, an empty boolean among them
+        skipped with a warning (OpenSCAD's is no geometry), and the first reason one of
+        the others has no vertex set (None: they all have one)."""
+        pairs, failure = [], None
+        for child in node.children:
+            kid = self.build(child)
+            if kid is None:
+                continue
             try:
-                if kid is not None:
-                    vertices(kid)
-            except NotAPolytope as err:
-                if err.empty:            # an empty boolean: OpenSCAD's is no geometry
-                    self.skip(child, f"{err} (its {what} takes the others)")
-                    empty.append(id(kid))
-        kids = [k for k in kids if id(k) not in empty]
-        try:
-            for kid in kids:
                 vertices(kid)
-        except NotAPolytope as err:
-            kids = self.facets.facet(self, node, what, err,
-                                     lambda faceted: faceted.children(node))
-        if kids and any(k.dim != kids[0].dim for k in kids):
-            for child, kid in zip(node.children, kids):
-                if kid.dim != kids[0].dim:
-                    self.skip(child, f"a {kid.dim}D child of a {kids[0].dim}D {what}")
-            kids = [k for k in kids if k.dim == kids[0].dim]
-        return kids
+            except NotAPolytope as err:
+                if err.empty:
+                    self.skip(child, f"{err} (its {what} takes the others)")
+                    continue
+                failure = failure or err
+            pairs.append((child, kid))
+        return pairs, failure
 
     def _hull(self, node: Node) -> Optional[Solid]:
         kids = self._polytope_children(node, "hull")

@@ -73,14 +73,6 @@ class Run:
         return Run.of(max_memory=max_memory, progress=progress, workers=self.workers,
                       executor=self.executor)
 
-    def serial(self) -> "Run":
-        """This run in this process alone (for a step that is not farmed out)."""
-        return replace(self, workers=1, executor=None)
-
-    def with_budget(self, budget: int) -> "Run":
-        """This run under another byte budget (a step given a share of it)."""
-        return replace(self, budget=int(budget))
-
     def workers_for(self, work: float) -> int:
         """The workers for ``work`` units (estimated surface voxels or pairs):
         :func:`implicitvox.parallel.plan_workers`; 1 means serial, here."""
