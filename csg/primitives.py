@@ -323,7 +323,7 @@ class Capsule(Solid):
     about its ends and the cylinder between them, ``min(|p - a| - r, |p - b| - r,
     max(rho - r, -w, w - |b - a|))`` with ``w`` the coordinate along the axis from ``a``
     and ``rho`` the distance from it (each affine in ``p``, so its intervals are tight: a
-    third fewer voxels at 48³ than the clipped-projection form
+    sixth fewer voxels at 48³, 5,268 against 6,347, than the clipped-projection form
     ``|p - a - t (b - a)| - r``). Its scene node is ``capsule``: ``a [3]``, ``b [3]``,
     ``r``.
 
