@@ -41,7 +41,7 @@ from ..interval.rules import (COMPILE, i_abs, i_acos, i_add, i_addc, i_asin, i_a
 from .pruning import FIRST, RELATIVE_GAP, SECOND, UNDECIDED
 from .tape import Tape
 
-__all__ = ["CompiledTape", "encode", "evaluate_boxes", "OPS", "BLOCK"]
+__all__ = ["CompiledTape", "encode", "compiled_tape", "evaluate_boxes", "OPS", "BLOCK"]
 
 #: boxes per block: each instruction runs over a block before the next one (its
 #: registers, two floats per box and register, stay in the core's cache)
@@ -123,6 +123,22 @@ def encode(tape: Tape) -> Optional[CompiledTape]:
         np.array([c.hi for c in tape.constants], dtype=np.float64),
         np.array([tape.inputs[name] for name in "xyz"], dtype=np.int32),
         tape.output, tape.undefined, branch, tape.branches)
+
+
+_ENCODED: dict[int, tuple[Tape, Optional[CompiledTape]]] = {}
+_ENCODED_LIMIT = 4096
+
+
+def compiled_tape(tape: Tape) -> Optional[CompiledTape]:
+    """:func:`encode`, once per tape object (the last :data:`_ENCODED_LIMIT` kept)."""
+    found = _ENCODED.get(id(tape))
+    if found is not None and found[0] is tape:
+        return found[1]
+    if len(_ENCODED) >= _ENCODED_LIMIT:
+        _ENCODED.clear()
+    encoded = encode(tape)
+    _ENCODED[id(tape)] = (tape, encoded)      # (holding the tape keeps its id unique)
+    return encoded
 
 
 def evaluate_boxes(tape: CompiledTape, lo: np.ndarray, hi: np.ndarray,
@@ -261,10 +277,10 @@ def _run_block(code, params, branch, rlo, rhi, m, empty, record, choices):
             for j in range(m):
                 lo_o[j], hi_o[j] = i_neg(lo_a[j], hi_a[j])
         elif op == ABS:
+            if record:    # first: the output may be the argument's register
+                _settle_abs(lo_a, hi_a, m, choices[branch[i]])
             for j in range(m):
                 lo_o[j], hi_o[j] = i_abs(lo_a[j], hi_a[j])
-            if record:
-                _settle_abs(lo_a, hi_a, m, choices[branch[i]])
         elif op == SQUARE:
             for j in range(m):
                 lo_o[j], hi_o[j] = i_square(lo_a[j], hi_a[j])

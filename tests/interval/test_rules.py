@@ -152,9 +152,11 @@ def test_choices_are_those_of_settle():
     whose branches the array evaluator settles against the whole tree)."""
     from implicitvox import x, y, z
     balls = [ivx.sqrt((x - c) ** 2 + y ** 2 + z ** 2) - 0.3 for c in (-0.6, 0.6)]
-    expr = ivx.max(ivx.min(*balls), ivx.abs(z) - 0.2)
+    expr = ivx.max(ivx.min(*balls), ivx.abs(z - 0.1) - 0.2)
     tape = build_tape(expr)
     assert set(tape.choice_trees) == {-1}
+    # abs writes over its argument's register: its choice must be read first
+    assert any(ins.op.name == "abs" and ins.out in ins.args for ins in tape.instructions)
     rng = np.random.default_rng(3)
     lo = rng.uniform(-1.0, 1.0, (3, 3000))
     hi = lo + rng.uniform(0.0, 0.3, (3, 3000))
