@@ -65,6 +65,7 @@ from ..octree.grid import Grid
 from ..octree.guard import MemoryGuard
 from ..octree import morton
 from ..octree.morton import CORNERS, NEIGHBOURS
+from ..octree.octants import run_counts
 from ..octree.subdivide import Subdivision, classify, subdivide
 from ..expr.shape import AMBIGUOUS
 
@@ -377,7 +378,7 @@ def adaptive_grid(func: Function, grid: Grid, refine: int, *,
         voxels = subdivide(func, grid, exact=exact, exact_voxels=exact_voxels, guard=guard,
                            prune=prune, progress=(lambda s: share(0.6 * s)))
     tapes = [t for _, t in voxels.tapes] or [func.tape]
-    tid = np.repeat(np.arange(len(voxels.tapes)), [n for n, _ in voxels.tapes]) \
+    tid = np.repeat(np.arange(len(voxels.tapes)), run_counts(voxels.tapes)) \
         if voxels.tapes else np.zeros(len(voxels.codes), dtype=np.int64)
     order = np.argsort(voxels.codes, kind="stable")
     cells = morton.decode(voxels.codes[order]).astype(np.int64)

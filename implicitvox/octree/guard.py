@@ -51,13 +51,15 @@ class MemoryGuard:
         self.bytes_per_octant = int(bytes_per_octant)
         self.estimated_voxels = estimated_voxels
 
-    def need(self, voxels: int, octants: int) -> int:
-        """Bytes for ``voxels`` kept surface voxels and ``octants`` other keys."""
-        return self.working + voxels * self.bytes_per_voxel + octants * self.bytes_per_octant
+    def need(self, voxels: int, octants: int, extra: int = 0) -> int:
+        """Bytes for ``voxels`` kept surface voxels and ``octants`` other keys, and
+        ``extra`` bytes more (what else the run holds: its tapes)."""
+        return (self.working + voxels * self.bytes_per_voxel + octants * self.bytes_per_octant
+                + extra)
 
-    def check(self, voxels: int, octants: int) -> None:
+    def check(self, voxels: int, octants: int, extra: int = 0) -> None:
         """Raise ``MemoryError`` if the run's holdings would pass the budget."""
-        need = self.need(voxels, octants)
+        need = self.need(voxels, octants, extra)
         if need <= self.budget:
             return
         said = "" if self.estimated_voxels is None else \

@@ -25,8 +25,7 @@ faster, still rounded outward).
 from __future__ import annotations
 
 import functools
-from dataclasses import dataclass, field
-from typing import Any, Callable, Optional
+from typing import Optional
 
 import numpy as np
 
@@ -37,13 +36,13 @@ from ..eval.tape import Tape
 from .frontier import Frontier
 from .grid import Grid
 from .guard import MemoryGuard
-from . import morton
-from ..eval.mean_value import mean_value_enclosure
-from .level_dtype import interval_dtype, level_dtype
+from .level_dtype import level_dtype
 from ..interval.float32 import outward_float32
 from ..eval.float32_tapes import supports_float32
-from ..expr.shape import AMBIGUOUS, EMPTY, FULL, Octants, takes_octants
+from ..expr.shape import AMBIGUOUS, FULL, Octants
 from .. import batches
+from .octants import (RECHECK, Progress, Subdivision, axes, by_tapes, classify, inside_children,
+                      pack, runs_compiled, states, suspect_voxels, tighten, unpack)
 
 __all__ = ["subdivide", "Subdivision", "classify", "classify_children", "suspect_voxels",
            "recheck_voxels", "prunes_at", "CHUNK", "RECHECK", "PRUNE_EVERY", "PRUNE_MIN_BELOW",
@@ -51,98 +50,12 @@ __all__ = ["subdivide", "Subdivision", "classify", "classify_children", "suspect
 
 #: octants classified per interval evaluation
 CHUNK = batches.FRONTIER
-#: default strength of the recheck (:func:`suspect_voxels`; measured in
-#: tests/benchmarks/bench_voxelize.py): 1/4 selects the voxels whose sub-voxels
-#: are predicted to settle them
-RECHECK = 0.25
-_CHILD_OFFSETS = morton.CORNERS.astype(np.int32)
 #: tapes are pruned every PRUNE_EVERY levels, down to PRUNE_MIN_BELOW levels above the
 #: voxels (:func:`prunes_at`)
 PRUNE_EVERY = 2
 PRUNE_MIN_BELOW = 3
 #: tapes shorter than this are not pruned further (:func:`prunes_at`)
 PRUNE_MIN_LENGTH = 128
-
-
-@dataclass
-class Subdivision:
-    """What a subdivision found."""
-
-    #: Morton codes (uint64) of the surface voxels, in no particular order
-    codes: np.ndarray
-    #: FULL octants per level: level -> (m, 3) int32 coordinates at that level, in
-    #: Morton order
-    interior: dict[int, np.ndarray] = field(default_factory=dict)
-    #: octants classified (boxes evaluated)
-    evaluated: int = 0
-    #: the tapes valid over the voxels, as runs ``(count, tape)`` in the order of
-    #: :attr:`codes` (pruned tapes, :mod:`implicitvox.eval.pruning`; with
-    #: ``leaf_level``, the tape of each code's ancestor at that level)
-    tapes: list = field(default_factory=list)
-    #: distinct pruned tapes built
-    tapes_built: int = 0
-    #: with ``until_level``: the AMBIGUOUS octants reached at that level (Morton
-    #: codes, sorted), not subdivided further: the subtrees a parallel run hands out
-    pending: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=np.uint64))
-
-    @property
-    def surface(self) -> np.ndarray:
-        """The surface voxels' coordinates, (n, 3) int32, in the order of :attr:`codes`."""
-        return _unpack(self.codes)
-
-
-def _states(flo: np.ndarray, fhi: np.ndarray) -> np.ndarray:
-    """EMPTY where ``flo > 0`` (also the empty interval ``(inf, -inf)``: undefined),
-    else FULL where ``fhi < 0``, else AMBIGUOUS; branch-free (the masks are random)."""
-    state = np.subtract(AMBIGUOUS, fhi < 0.0, dtype=np.int8)   # FULL = AMBIGUOUS - 1
-    state *= flo <= 0.0                                         # EMPTY = 0
-    return state
-
-
-def classify(func: Function, grid: Grid, level: int, coords: np.ndarray,
-             exact: Optional[Callable[[np.ndarray, np.ndarray], np.ndarray]] = None,
-             mean_value: bool = False, dtype=None, run: Optional[dict] = None) -> np.ndarray:
-    """States (int8) of octants ``coords`` at ``level``: EMPTY, FULL or AMBIGUOUS.
-
-    The natural interval extension decides first; octants it leaves
-    AMBIGUOUS get the mean value form (:mod:`implicitvox.eval.mean_value`) when
-    ``mean_value``, then the shape's exact test. A box's state depends on the
-    box alone, not on the level or the run, so ``Voxels.refine`` matches a
-    direct voxelization: the natural extension runs in the float type that
-    :func:`implicitvox.octree.level_dtype.interval_dtype` picks for the box size
-    (``dtype`` None), or in ``dtype``. ``run``: the subdivision's scratch space,
-    for an exact test that takes the octants (:class:`~implicitvox.expr.shape.Octants`).
-    """
-    lo, hi = grid.octant_boxes(level, coords)
-    if dtype is None:
-        dtype = interval_dtype(func.tape, grid, level)
-    flo, fhi = func.interval_columns(lo, hi, dtype)
-    state = _states(flo, fhi)
-    octants = None if run is None else Octants(level, _pack(coords), run)
-    return _tighten(func.tape, lo, hi, flo, fhi, state, exact, mean_value, octants)
-
-
-def _tighten(tape: Tape, lo, hi, flo: np.ndarray, fhi: np.ndarray, state: np.ndarray,
-             exact, mean_value: bool, octants: Optional[Octants] = None) -> np.ndarray:
-    """Settle the AMBIGUOUS states further: the mean value form (reusing the
-    natural bounds ``flo, fhi`` already computed), then the exact test (given
-    the ``octants`` of the boxes when it takes them)."""
-    if mean_value:
-        amb = np.flatnonzero(state == AMBIGUOUS)
-        if amb.size:
-            sub_lo, sub_hi = tuple(c[amb] for c in lo), tuple(c[amb] for c in hi)
-            mlo, mhi = mean_value_enclosure(tape, sub_lo, sub_hi, (flo[amb], fhi[amb]))
-            state[amb] = _states(mlo, mhi)
-    if exact is not None:
-        amb = np.flatnonzero(state == AMBIGUOUS)
-        if amb.size:
-            lo_arr = np.stack([c[amb] for c in lo], axis=1)
-            hi_arr = np.stack([c[amb] for c in hi], axis=1)
-            if octants is not None and takes_octants(exact):
-                state[amb] = exact(lo_arr, hi_arr, octants.subset(amb))
-            else:
-                state[amb] = exact(lo_arr, hi_arr)
-    return state
 
 
 _BROADCAST = [(1, 1, 2, -1), (1, 2, 1, -1), (2, 1, 1, -1)]
@@ -152,19 +65,6 @@ _BROADCAST = [(1, 1, 2, -1), (1, 2, 1, -1), (2, 1, 1, -1)]
 # per octant, and the surface voxels come out ready for the octree.
 _SLOTS = np.arange(8, dtype=np.uint64)
 _THREE = np.uint64(3)
-
-
-def _pack(coords: np.ndarray) -> np.ndarray:
-    return morton.encode(np.asarray(coords).reshape(-1, 3))
-
-
-def _axes(keys: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    c = morton.decode(keys)
-    return c[:, 0], c[:, 1], c[:, 2]
-
-
-def _unpack(keys: np.ndarray) -> np.ndarray:
-    return morton.decode(keys).astype(np.int32)
 
 
 def _child_boxes(grid: Grid, level: int, parents: tuple[np.ndarray, ...], single: bool = False):
@@ -220,21 +120,21 @@ def _child_edges(grid: Grid, level: int, axis: int, single: bool
     return low, high
 
 
-def _child_states(tape: Tape, grid: Grid, level: int, parents: np.ndarray, dtype,
+def _childstates(tape: Tape, grid: Grid, level: int, parents: np.ndarray, dtype,
                   record: bool = False):
     """States (8, m) of the children of octants ``parents`` (Morton codes) at
     ``level``, child-major, EMPTY past the grid; their bounds (8 m), the
     number of children inside the grid, which are inside, and (``record``)
     the branch choices ``(len(tape.branches), 8 m)`` over them."""
-    axes = _axes(parents)
-    lo, hi = _child_boxes(grid, level, axes, single=np.dtype(dtype) == np.float32)
+    parent_axes = axes(parents)
+    lo, hi = _child_boxes(grid, level, parent_axes, single=np.dtype(dtype) == np.float32)
     choices = np.empty((len(tape.branches), 2, 2, 2, len(parents)), dtype=np.int8) \
         if record else None
     flo, fhi = evaluate_intervals(tape, lo, hi, dtype, native=True, choices=choices)
     flo, fhi = flo.reshape(-1), fhi.reshape(-1)     # child-major: index = child * m + parent
-    state = _states(flo, fhi)
+    state = states(flo, fhi)
     classified = state.size
-    inside = _inside_children(grid, level + 1, axes)
+    inside = inside_children(grid, level + 1, parent_axes)
     if inside is not None:
         state *= inside
         classified = int(np.count_nonzero(inside))
@@ -279,16 +179,16 @@ def classify_children(tape: Tape, grid: Grid, level: int, parents: np.ndarray,
     """
     record = pruner is not None and bool(tape.branches) and prunes_at(level, grid.depth,
                                                                       len(tape))
-    state, flo, fhi, classified, inside, choices = _child_states(tape, grid, level, parents,
+    state, flo, fhi, classified, inside, choices = _childstates(tape, grid, level, parents,
                                                                  dtype, record)
     kids = ((parents << _THREE)[None, :] | _SLOTS[:, None]).reshape(-1)
     if mean_value or exact is not None:
         amb = np.flatnonzero(state == AMBIGUOUS)
         if amb.size:
             # the natural bounds are known: only the boxes are rebuilt, as columns
-            box_lo, box_hi = grid.octant_boxes(level + 1, _unpack(kids[amb]))
+            box_lo, box_hi = grid.octant_boxes(level + 1, unpack(kids[amb]))
             octants = None if run is None else Octants(level + 1, kids[amb], run)
-            state[amb] = _tighten(tape, box_lo, box_hi, flo[amb].astype(np.float64),
+            state[amb] = tighten(tape, box_lo, box_hi, flo[amb].astype(np.float64),
                                   fhi[amb].astype(np.float64), state[amb], exact, mean_value,
                                   octants)
     ambiguous = state == AMBIGUOUS
@@ -312,50 +212,6 @@ def classify_children(tape: Tape, grid: Grid, level: int, parents: np.ndarray,
             classified)
 
 
-def suspect_voxels(flo: np.ndarray, fhi: np.ndarray, m: int, recheck: float,
-                   inside: Optional[np.ndarray] = None) -> np.ndarray:
-    """Which voxels (the ``8 m`` children of ``m`` octants, child-major, with
-    enclosures ``[flo, fhi]``) to recheck on their sub-voxels.
-
-    A natural interval enclosure of width ``W`` overestimates the true range
-    ``w`` of ``f`` over a voxel (by the triangle inequality, where the terms of
-    ``f`` partly cancel; Stolte §1). The 8 children of one octant sit on a
-    2 x 2 x 2 lattice one voxel apart, so the spread of their enclosures'
-    midpoints (each ``f`` at a child centre, to second order) estimates ``w``
-    without further evaluation: ``rho = spread / W`` (for linear ``f``, exactly
-    ``w / W``). A sub-voxel's enclosure is about ``W / 2`` wide and centred up
-    to ``w / 4`` nearer 0 than the voxel's midpoint ``c``, so all 8 exclude 0
-    when ``|c| > (W + w) / 4``: when 0 lies within ``(1 - rho) / 4`` of the
-    width from an end. A voxel is a suspect when 0 lies within ``recheck (1 -
-    rho) W`` of an end: ``recheck = 1/4`` is the prediction itself, larger
-    values recheck more. Children outside the grid (``inside`` False) do not
-    count in the spread. For affine ``f`` the prediction is exact
-    (``tests/test_voxelize.py``).
-
-    Examples
-    --------
-    One octant whose 8 children have enclosures of width 1 and midpoints
-    spread over 0.49 (``rho = 0.49``): the suspects are those with 0 within
-    ``0.25 * 0.51`` of an end.
-
-    >>> import numpy as np
-    >>> mid = np.array([0.0, 0.1, 0.2, 0.3, 0.4, 0.45, 0.48, 0.49])
-    >>> suspect_voxels(mid - 0.5, mid + 0.5, 1, 0.25)
-    array([False, False, False, False,  True,  True,  True,  True])
-    """
-    with np.errstate(invalid="ignore"):   # in float64 also for float32 bounds (exactly)
-        twice_mid = np.add(flo, fhi, dtype=np.float64).reshape(8, m)
-        if inside is not None:
-            twice_mid[~inside.reshape(8, m)] = np.nan
-        spread = np.fmax.reduce(twice_mid, axis=0)          # fmax, fmin: NaN ignored
-        spread -= np.fmin.reduce(twice_mid, axis=0)
-        spread *= 0.5
-        margin = np.subtract(fhi, flo, dtype=np.float64)
-        margin.reshape(8, m)[...] -= spread
-        margin *= recheck
-        return np.minimum(-flo, fhi) <= margin
-
-
 def recheck_voxels(tape: Tape, grid: Grid, codes: np.ndarray, dtype
                    ) -> tuple[np.ndarray, np.ndarray, int]:
     """Settle suspect voxels (Morton codes at ``grid.depth``) on their 8 sub-voxels.
@@ -373,46 +229,11 @@ def recheck_voxels(tape: Tape, grid: Grid, codes: np.ndarray, dtype
     """
     fine = grid.finer(1)
     sub_dtype = level_dtype(fine, fine.depth) if np.dtype(dtype) == np.float32 else np.float64
-    state, _, _, classified, _, _ = _child_states(tape, fine, grid.depth, codes, sub_dtype)
+    state, _, _, classified, _, _ = _childstates(tape, fine, grid.depth, codes, sub_dtype)
     state = state.reshape(8, -1)
     met = (state == AMBIGUOUS).any(axis=0)
     inside = (state == FULL).all(axis=0)
     return codes[met], codes[inside], classified
-
-
-def _inside_children(grid: Grid, level: int, axes) -> Optional[np.ndarray]:
-    """Which children (child-major, ``8 m``) at ``level`` of the parents with
-    coordinates ``axes`` meet the grid (None: all)."""
-    if all(n == 1 << grid.depth for n in grid.shape):
-        return None
-    limits = [-(-n // (1 << (grid.depth - level))) for n in grid.shape]  # octants per axis
-    inside = np.ones((8, len(axes[0])), dtype=bool)
-    for a in range(3):
-        inside &= (axes[a][None, :] * 2 + _CHILD_OFFSETS[:, a, None]) < limits[a]
-    return inside.reshape(-1)
-
-
-class _Progress:
-    """Share of the estimated work done, reported non-decreasing.
-
-    The number of octants to classify grows about 4 times per level near a
-    surface (Stolte §4.1.3), so the children of ``m`` pending octants at level
-    ``l`` are estimated at ``8 m (4**(depth - l) - 1) / 3`` classifications.
-    """
-
-    def __init__(self, hook: Optional[Callable[[float], Any]], depth: int):
-        self.hook, self.depth, self.done, self.last = hook, depth, 0, 0.0
-
-    def estimate(self, m: int, level: int) -> float:
-        return 8.0 * m * (4.0 ** (self.depth - level) - 1.0) / 3.0
-
-    def report(self, frontier: Frontier) -> None:
-        if self.hook is None:
-            return
-        pending = sum(self.estimate(count, lvl) for lvl, count in frontier.sizes())
-        share = self.done / (self.done + pending) if pending else 1.0
-        self.last = max(self.last, min(share, 1.0))
-        self.hook(self.last)
 
 
 def subdivide(func: Function, grid: Grid, *, start: Optional[tuple[int, np.ndarray]] = None,
@@ -465,6 +286,12 @@ def subdivide(func: Function, grid: Grid, *, start: Optional[tuple[int, np.ndarr
         (``start``) gives, together, exactly the serial run's voxels and
         interior (a box's state depends on the box alone).
     """
+    if runs_compiled(func.tape, grid):
+        from .descend import descend     # (loads Numba: not at import)
+        return descend(func, grid, start=start, interior=interior, exact=exact,
+                       progress=progress, chunk=chunk, mean_value=mean_value,
+                       exact_voxels=exact_voxels, recheck=recheck, guard=guard, prune=prune,
+                       leaf_level=leaf_level, until_level=until_level)
     depth = grid.depth
     leaf_level = depth if leaf_level is None else leaf_level
     per_step = max(1, chunk // 8)
@@ -485,16 +312,16 @@ def subdivide(func: Function, grid: Grid, *, start: Optional[tuple[int, np.ndarr
                          run=run)
         evaluated = 1
         if state[0] == FULL and interior:
-            interior_parts[0] = [_pack(root)]
+            interior_parts[0] = [pack(root)]
         elif state[0] == AMBIGUOUS:
             if depth == 0:
-                surface.append((_pack(root), base))
+                surface.append((pack(root), base))
             else:
-                frontier.push(0, _pack(root), base, base if leaf_level == 0 else None)
+                frontier.push(0, pack(root), base, base if leaf_level == 0 else None)
     else:
         level0, coords0 = start
-        frontier.push(level0, _pack(coords0), base, base if level0 >= leaf_level else None)
-    meter = _Progress(progress, depth)
+        frontier.push(level0, pack(coords0), base, base if level0 >= leaf_level else None)
+    meter = Progress(progress, depth)
     single = supports_float32(base)
     voxel_dtype = level_dtype(grid, depth) if single else np.float64
     suspects: list[tuple[np.ndarray, Tape, Tape]] = []
@@ -505,7 +332,7 @@ def subdivide(func: Function, grid: Grid, *, start: Optional[tuple[int, np.ndarr
 
     def settle_suspects() -> int:
         classified = 0
-        for codes, tape, leaf_tape in _by_tapes(suspects):
+        for codes, tape, leaf_tape in by_tapes(suspects):
             met, full, count = recheck_voxels(tape, grid, codes, voxel_dtype)
             classified += count
             surface.append((met, leaf_tape))
@@ -552,21 +379,12 @@ def subdivide(func: Function, grid: Grid, *, start: Optional[tuple[int, np.ndarr
     if progress is not None:
         progress(1.0)
     runs = [(codes, base if tape is None else tape) for codes, tape, _ in
-            _by_tapes([(c, t, t) for c, t in surface])]
+            by_tapes([(c, t, t) for c, t in surface])]
     return Subdivision(
         codes=np.concatenate([c for c, _ in runs]) if runs else np.zeros(0, dtype=np.uint64),
-        interior={lvl: _unpack(np.sort(np.concatenate(parts)))   # Morton order: any schedule
+        interior={lvl: unpack(np.sort(np.concatenate(parts)))   # Morton order: any schedule
                   for lvl, parts in sorted(interior_parts.items())},
         evaluated=evaluated, tapes=[(len(c), t) for c, t in runs],
         tapes_built=pruner.built if pruner is not None else 0,
         pending=np.sort(np.concatenate(held_back)) if held_back else
         np.zeros(0, dtype=np.uint64))
-
-
-def _by_tapes(parts: list) -> list:
-    """Parts ``(codes, tape, leaf_tape)`` merged where both tapes are the same objects."""
-    merged: dict[tuple[int, int], tuple[list, Any, Any]] = {}
-    for codes, tape, leaf_tape in parts:
-        merged.setdefault((id(tape), id(leaf_tape)), ([], tape, leaf_tape))[0].append(codes)
-    return [(np.concatenate(c) if len(c) > 1 else c[0], tape, leaf_tape)
-            for c, tape, leaf_tape in merged.values()]

@@ -19,6 +19,7 @@ from . import morton
 from .grid import Grid
 from .guard import MemoryGuard
 from .morton import MAX_BITS
+from .octants import recount, run_counts
 from .subdivide import RECHECK, Subdivision, subdivide
 
 __all__ = ["SurfaceOptions", "subdivide_voxels", "interior_from_subvoxels", "voxel_normals",
@@ -115,12 +116,12 @@ def subdivide_voxels(func: Function, grid: Grid, options: SurfaceOptions, exact:
     if not s:
         return result
     # the voxels holding them, each with the tape of one of its sub-voxels (all have the voxel's)
-    run_of = np.repeat(np.arange(len(result.tapes)), [n for n, _ in result.tapes])
+    run_of = np.repeat(np.arange(len(result.tapes)), run_counts(result.tapes))
     result.codes, first = np.unique(result.codes >> np.uint64(3 * s), return_index=True)
     order = np.argsort(run_of[first], kind="stable")
     result.codes = result.codes[order]
     counts = np.bincount(run_of[first], minlength=len(result.tapes))
-    result.tapes = [(int(c), t) for c, (_, t) in zip(counts, result.tapes) if c]
+    result.tapes = recount(result.tapes, counts)
     result.interior = interior_from_subvoxels(result.interior, grid, s)
     return result
 

@@ -13,6 +13,7 @@ from hypothesis import given, settings, strategies as st
 import implicitvox as ivx
 from csg import Box, Cylinder, Sphere, read_openscad
 from implicitvox.expr.examples import drilled_plate, menger, sphere_union
+from implicitvox.octree import descend
 from implicitvox.octree import subdivide as subdivision
 from tests.properties.test_never_misses import MODELS
 
@@ -24,10 +25,12 @@ RES = 40
 def prune_every_tape(monkeypatch):
     """Prune tapes of any length at every level above the voxels (the defaults leave
     short tapes and the last levels alone, for speed), so these small models and
-    grids exercise the pruned paths."""
+    grids exercise the pruned paths: the array subdivision's knobs, and the compiled
+    one's cost of a derivation."""
     monkeypatch.setattr(subdivision, "PRUNE_MIN_LENGTH", 0)
     monkeypatch.setattr(subdivision, "PRUNE_MIN_BELOW", 1)
     monkeypatch.setattr(subdivision, "PRUNE_EVERY", 1)
+    monkeypatch.setattr(descend, "DERIVE_COST", 0)
 
 
 def _digest(vox) -> str:
