@@ -18,5 +18,15 @@ from hypothesis import settings
 os.environ.setdefault("IMPLICITVOX_WORKERS", "1")
 
 settings.register_profile("ci", derandomize=True, deadline=None, print_blob=True)
+
+
+def pytest_configure(config):
+    """Compile the kernel once, here in the controller, before pytest-xdist starts its
+    workers: they (and the processes the tests start) then load Numba's on-disk
+    cache instead of each compiling the same functions (about 25 s apiece cold)."""
+    if hasattr(config, "workerinput"):       # a worker: the controller did it
+        return
+    from implicitvox.octree.descend import warm_up
+    warm_up()
 if os.environ.get("CI"):
     settings.load_profile("ci")

@@ -194,7 +194,7 @@ class TapePool:
         self.grow(1, len(choices))
         settled = np.flatnonzero(choices)
         key = (settled * 4 + np.asarray(choices)[settled]).astype(np.int32)
-        return int(prune_tape(tape, key, len(key), *self.arrays()))
+        return int(prune_tape(np.int64(tape), key, np.int64(len(key)), *self.arrays()))
 
     def tape(self, index: int) -> Tape:
         """Pool tape ``index`` as a :class:`Tape` (built once)."""
@@ -238,7 +238,8 @@ def _rehashed(table):
             slot = h & mask
             while bigger[slot, 0] != 0:
                 slot = (slot + 1) & mask
-            bigger[slot] = table[k]
+            for col in range(table.shape[1]):
+                bigger[slot, col] = table[k, col]
     return bigger
 
 
@@ -399,7 +400,8 @@ def prune_tape(tape, key, n_key, rows, tapes, derivations, contents, keys, used,
     entry = derivations[slot]
     entry[D_HASH], entry[D_TAPE], entry[D_PARENT] = h, child, tape
     entry[D_KEY], entry[D_KEYS] = used[USED_KEYS], n_key
-    keys[used[USED_KEYS]:used[USED_KEYS] + n_key] = key[:n_key]
+    for k in range(n_key):
+        keys[used[USED_KEYS] + k] = key[k]
     used[USED_KEYS] += n_key
     used[USED_DERIVATIONS] += 1
     return child

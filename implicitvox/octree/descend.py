@@ -45,27 +45,19 @@ from typing import Optional
 import numpy as np
 from numba import njit
 
-from ..eval.compiled import (ABS, ACOS, ADD, ADDC, ASIN, ATAN, ATAN2, COS, DISTANCE, DIV, DIVC,
-                             ELEVATION, EXP, FLOOR, HYPOT, LOG, MAX, MIN, MUL, MULC, NEG,
-                             PERIODIC_ANGLE, POWI, POWR, RADIUS, RSUBC, SIN, SQRT, SQUARE, SUB,
-                             TAN)
-from ..eval.pruning import FIRST, RELATIVE_GAP, SECOND
+from ..eval.compiled import ABS, MAX, MIN, is_domain, run_row
 from ..eval.tape_pool import (ARG_A, ARG_B, ARG_C, MASK, MASK_A, MASK_B, MASK_C, OP, OUT,
                               OUTPUT, REGISTERS, ROOT, ROWS, START, VALUE, TapePool, prune_tape)
 from ..eval.function import Function
 from ..expr.shape import AMBIGUOUS, EMPTY, FULL, Octants
-from ..interval.rules import (COMPILE, i_abs, i_acos, i_add, i_addc, i_asin, i_atan, i_atan2,
-                              i_cos, i_distance, i_div, i_divc, i_elevation, i_exp, i_floor,
-                              i_hypot, i_log, i_max, i_min, i_mul, i_mulc, i_neg,
-                              i_periodic_angle, i_powi, i_powr, i_radius, i_rsubc, i_sin, i_sqrt,
-                              i_square, i_sub, i_tan)
+from ..interval.rules import COMPILE
 from .grid import Grid
 from .guard import MemoryGuard
 from .octants import (MAX_SIDE, RECHECK, Progress, Subdivision, TapeRuns, classify, pack,
                       tighten, unpack)
 from .. import batches
 
-__all__ = ["descend", "Descent", "Entries", "EntryFrontier", "BLOCK_PARENTS", "DERIVE_COST", "CHUNK"]
+__all__ = ["descend", "warm_up", "Descent", "Entries", "EntryFrontier", "BLOCK_PARENTS", "DERIVE_COST", "CHUNK"]
 
 #: octants classified per step of the driver
 CHUNK = batches.FRONTIER
@@ -82,8 +74,8 @@ class Entries:
     def __init__(self, codes: np.ndarray, tapes, leaves):
         n = len(codes)
         self.codes = np.asarray(codes, dtype=np.uint64)
-        self.tapes = np.broadcast_to(np.asarray(tapes, dtype=np.int32), (n,))
-        self.leaves = np.broadcast_to(np.asarray(leaves, dtype=np.int32), (n,))
+        self.tapes = _column(tapes, n)
+        self.leaves = _column(leaves, n)
 
     def __len__(self) -> int:
         return len(self.codes)
@@ -97,6 +89,12 @@ class Entries:
             return parts[0]
         return Entries(*(np.concatenate([getattr(p, k) for p in parts])
                          for k in ("codes", "tapes", "leaves")))
+
+
+def _column(values, n: int) -> np.ndarray:
+    """``values`` (or one value) as a writable int32 array of ``n``."""
+    values = np.asarray(values, dtype=np.int32)
+    return np.full(n, values, dtype=np.int32) if values.ndim == 0 else values
 
 
 class EntryFrontier:
@@ -145,7 +143,6 @@ class EntryFrontier:
 
 #: octants whose children are evaluated together (8 children each)
 BLOCK_PARENTS = 64
-GAP = RELATIVE_GAP[np.dtype(np.float64)]
 #: what deriving a child's tape costs per row of its parent's, in row evaluations of
 #: one box: a child gets its own tape when the rows its settled choices drop (at
 #: least one each), times the boxes its subtree evaluates, exceed that cost (0:
@@ -155,6 +152,18 @@ DERIVE_COST = 10
 #: keeps its parent's tape: the pool grows before the next call)
 TAPES_PER_CALL = 1 << 14
 ROWS_PER_CALL = 1 << 17
+
+
+def warm_up() -> None:
+    """Compile the kernel's functions, or load them from Numba's on-disk cache: one
+    small run through every compiled path (about 25 s the first time on a 2-core
+    machine, a second once cached). The test suite calls it once before its
+    workers start, so they load what it wrote instead of each compiling."""
+    from ..expr import functions as fn
+    from ..expr.nodes import x, y, z
+    parts = fn.min(fn.sqrt(x * x + y * y + z * z) - 0.5, fn.abs(x) - 0.3)
+    descend(Function(fn.max(parts, -parts - 0.1)), Grid.from_bounds(((-1.0,) * 3, (1.0,) * 3), 8),
+            interior=True)
 
 
 def descend(func: Function, grid: Grid, *, start: Optional[tuple[int, np.ndarray]] = None,
@@ -358,13 +367,23 @@ class Descent:
         used = len(pool)
         registers = int(pool.tapes[:used, REGISTERS].max())
         rows = int(pool.tapes[:used, ROWS].max())
-        classified = _classify(*self._edges(level), np.ascontiguousarray(parents, np.uint64),
-                               np.ascontiguousarray(tapes, np.int32), prune, registers, rows,
+        # (writable contiguous arrays, as Numba compiled _classify for)
+        tapes = np.require(tapes, np.int32, ("C", "W"))
+        parents = np.require(parents, np.uint64, ("C", "W"))
+        order = np.argsort(tapes, kind="stable")
+        lanes = 8 * BLOCK_PARENTS
+        width = max(rows, 1)
+        buffers = (np.zeros((registers, lanes)), np.zeros((registers, lanes)),
+                   np.zeros(lanes, dtype=np.bool_), np.zeros(lanes, dtype=np.bool_),
+                   np.zeros((width, lanes), dtype=np.int8), np.zeros(width, dtype=np.int32),
+                   np.zeros(width, dtype=np.int64), np.zeros(width, dtype=np.int64),
+                   np.zeros((3, BLOCK_PARENTS), dtype=np.int64))
+        classified = _classify(*self._edges(level), parents, tapes, bool(prune),
                                _subtree_boxes(self.grid.depth - level - 2), DERIVE_COST,
                                float(recheck),
                                pool.params, pool.constant_lo, pool.constant_hi,
                                pool.is_constant, pool.inputs, *pool.arrays(),
-                               order, state, flo, fhi, child_tapes, suspects)
+                               order, state, flo, fhi, child_tapes, suspects, *buffers)
         return order, state, flo, fhi, child_tapes, suspects, int(classified)
 
 
@@ -387,33 +406,19 @@ def _compact(v):
 
 
 @njit(**COMPILE)
-def _is_domain(op):
-    return op == SQRT or op == LOG or op == ASIN or op == ACOS or op == POWR
-
-
-@njit(**COMPILE)
-def _classify(xlo, xhi, ylo, yhi, zlo, zhi, limits, parents, tapes, prune, n_registers, max_rows,
+def _classify(xlo, xhi, ylo, yhi, zlo, zhi, limits, parents, tapes, prune,
               subtree, derive_cost, recheck, params, constant_lo, constant_hi, is_constant, inputs,
               rows, tapes_, derivations, contents, keys, used, masks, domain, fixed, scratch, kept,
-              order, state, flo, fhi, child_tapes, suspects):
+              order, state, flo, fhi, child_tapes, suspects, rlo, rhi, empty, outside, choices,
+              key, branch_rows, branch_masks, coords):
+    """:meth:`Descent.children` (``order``: the parents by tape, given; the buffers
+    from the caller: allocations and slice assignments are slow to compile)."""
     m = parents.size
-    order[:] = np.argsort(tapes, kind="mergesort")
-    lanes = 8 * BLOCK_PARENTS
-    rlo = np.zeros((n_registers, lanes))
-    rhi = np.zeros((n_registers, lanes))
-    empty = np.zeros(lanes, dtype=np.bool_)
-    outside = np.zeros(lanes, dtype=np.bool_)
-    choices = np.zeros((max(max_rows, 1), lanes), dtype=np.int8)
-    key = np.zeros(max(max_rows, 1), dtype=np.int32)
-    branch_rows = np.zeros(max(max_rows, 1), dtype=np.int64)
-    branch_masks = np.zeros(max(max_rows, 1), dtype=np.int64)
-    ci = np.zeros(BLOCK_PARENTS, dtype=np.int64)
-    cj = np.zeros(BLOCK_PARENTS, dtype=np.int64)
-    ck = np.zeros(BLOCK_PARENTS, dtype=np.int64)
+    ci, cj, ck = coords[0], coords[1], coords[2]
     classified = 0
     k = 0
     while k < m:
-        t = tapes[order[k]]
+        t = np.int64(tapes[order[k]])
         e = k + 1
         while e < m and e - k < BLOCK_PARENTS and tapes[order[e]] == t:
             e += 1
@@ -441,7 +446,8 @@ def _classify(xlo, xhi, ylo, yhi, zlo, zhi, limits, parents, tapes, prune, n_reg
                 if inputs[2] >= 0:
                     rlo[inputs[2], lane] = zlo[(s >> 2) & 1, ck[q]]
                     rhi[inputs[2], lane] = zhi[(s >> 2) & 1, ck[q]]
-        empty[:8 * n] = False
+        for j in range(8 * n):
+            empty[j] = False
         start = tapes_[t, START]
         count = tapes_[t, ROWS]
         n_branches = 0
@@ -453,10 +459,13 @@ def _classify(xlo, xhi, ylo, yhi, zlo, zhi, limits, parents, tapes, prune, n_reg
                 branch_masks[n_branches] = row[MASK]
                 n_branches += 1
             v = row[VALUE]
-            _run_row(op, row[OUT], row[ARG_A], row[ARG_B], row[ARG_C], row[MASK], row[MASK_A],
-                     row[MASK_B], row[MASK_C], r, params[v, 0], params[v, 1], params[v, 2], n,
-                     rlo, rhi, outside, choices)
-            if _is_domain(op):      # the flags of the slots it computed, to every child
+            # (int64 arguments, as evaluate_boxes passes them: one compiled run_row)
+            run_row(np.int64(op), np.int64(row[OUT]), np.int64(row[ARG_A]),
+                    np.int64(row[ARG_B]), np.int64(row[ARG_C]), np.int64(row[MASK]),
+                    np.int64(row[MASK_A]), np.int64(row[MASK_B]), np.int64(row[MASK_C]),
+                    np.int64(r), params[v, 0], params[v, 1], params[v, 2], np.int64(n),
+                    rlo, rhi, outside, choices)
+            if is_domain(op):      # the flags of the slots it computed, to every child
                 mo = row[MASK]
                 for s in range(8):
                     for q in range(n):
@@ -495,7 +504,7 @@ def _classify(xlo, xhi, ylo, yhi, zlo, zhi, limits, parents, tapes, prune, n_reg
                                 n_key += 1
                         if n_key * subtree >= derive_cost * count:
                             child_tapes[index] = prune_tape(
-                                t, key, n_key, rows, tapes_, derivations, contents, keys, used,
+                                t, key, np.int64(n_key), rows, tapes_, derivations, contents, keys, used,
                                 masks, domain, fixed, scratch, kept)
                 if inside:
                     classified += 1
@@ -528,264 +537,3 @@ def _pick_suspects(flo, fhi, first, i, j, k, limits, recheck, suspects):
         lo, hi = flo[first + s], fhi[first + s]
         margin = ((hi - lo) - spread) * recheck
         suspects[first + s] = min(-lo, hi) <= margin
-
-
-@njit(inline="always", **COMPILE)
-def _run_row(op, o, a, b, c, mo, ma, mb, mc, r, p0, p1, p2, n, rlo, rhi, outside, choices):
-    """One row over the block's ``8 n`` children (lanes ``s * n + q``, slot ``s``), on
-    the slots its mask distinguishes; an argument is read at the slot of its own
-    mask. Its choices (``min, max, abs``) and domain flags (``outside``) are left at
-    those slots too."""
-    if op == MIN:
-        for s in range(8):
-            if (s & ~mo) != 0:
-                continue
-            so, sa, sb, sc = s * n, (s & ma) * n, (s & mb) * n, (s & mc) * n
-            for q in range(n):
-                a0, a1, b0, b1 = rlo[a, sa + q], rhi[a, sa + q], rlo[b, sb + q], rhi[b, sb + q]
-                margin = (abs(a0) + abs(b0) + abs(a1) + abs(b1)) * GAP
-                choices[r, so + q] = FIRST * (a1 + margin < b0) + SECOND * (b1 + margin < a0)
-                rlo[o, so + q], rhi[o, so + q] = i_min(a0, a1, b0, b1)
-    elif op == MAX:
-        for s in range(8):
-            if (s & ~mo) != 0:
-                continue
-            so, sa, sb, sc = s * n, (s & ma) * n, (s & mb) * n, (s & mc) * n
-            for q in range(n):
-                a0, a1, b0, b1 = rlo[a, sa + q], rhi[a, sa + q], rlo[b, sb + q], rhi[b, sb + q]
-                margin = (abs(a0) + abs(b0) + abs(a1) + abs(b1)) * GAP
-                choices[r, so + q] = SECOND * (a1 + margin < b0) + FIRST * (b1 + margin < a0)
-                rlo[o, so + q], rhi[o, so + q] = i_max(a0, a1, b0, b1)
-    elif op == ADDC:
-        for s in range(8):
-            if (s & ~mo) != 0:
-                continue
-            so, sa, sb, sc = s * n, (s & ma) * n, (s & mb) * n, (s & mc) * n
-            for q in range(n):
-                rlo[o, so + q], rhi[o, so + q] = i_addc(rlo[a, sa + q], rhi[a, sa + q], p0)
-    elif op == RSUBC:
-        for s in range(8):
-            if (s & ~mo) != 0:
-                continue
-            so, sa, sb, sc = s * n, (s & ma) * n, (s & mb) * n, (s & mc) * n
-            for q in range(n):
-                rlo[o, so + q], rhi[o, so + q] = i_rsubc(rlo[a, sa + q], rhi[a, sa + q], p0)
-    elif op == MULC:
-        for s in range(8):
-            if (s & ~mo) != 0:
-                continue
-            so, sa, sb, sc = s * n, (s & ma) * n, (s & mb) * n, (s & mc) * n
-            for q in range(n):
-                rlo[o, so + q], rhi[o, so + q] = i_mulc(rlo[a, sa + q], rhi[a, sa + q], p0)
-    elif op == DIVC:
-        for s in range(8):
-            if (s & ~mo) != 0:
-                continue
-            so, sa, sb, sc = s * n, (s & ma) * n, (s & mb) * n, (s & mc) * n
-            for q in range(n):
-                rlo[o, so + q], rhi[o, so + q] = i_divc(rlo[a, sa + q], rhi[a, sa + q], p0)
-    elif op == DISTANCE:
-        for s in range(8):
-            if (s & ~mo) != 0:
-                continue
-            so, sa, sb, sc = s * n, (s & ma) * n, (s & mb) * n, (s & mc) * n
-            for q in range(n):
-                rlo[o, so + q], rhi[o, so + q] = i_distance(rlo[a, sa + q], rhi[a, sa + q],
-                                                            rlo[b, sb + q], rhi[b, sb + q],
-                                                            rlo[c, sc + q], rhi[c, sc + q], p0,
-                                                            p1, p2)
-    elif op == ABS:
-        for s in range(8):
-            if (s & ~mo) != 0:
-                continue
-            so, sa, sb, sc = s * n, (s & ma) * n, (s & mb) * n, (s & mc) * n
-            for q in range(n):
-                a0, a1 = rlo[a, sa + q], rhi[a, sa + q]
-                margin = (abs(a0) + abs(a1)) * GAP
-                choices[r, so + q] = FIRST * (a0 > margin) + SECOND * (a1 < -margin)
-                rlo[o, so + q], rhi[o, so + q] = i_abs(a0, a1)
-    elif op == NEG:
-        for s in range(8):
-            if (s & ~mo) != 0:
-                continue
-            so, sa, sb, sc = s * n, (s & ma) * n, (s & mb) * n, (s & mc) * n
-            for q in range(n):
-                rlo[o, so + q], rhi[o, so + q] = i_neg(rlo[a, sa + q], rhi[a, sa + q])
-    elif op == SQUARE:
-        for s in range(8):
-            if (s & ~mo) != 0:
-                continue
-            so, sa, sb, sc = s * n, (s & ma) * n, (s & mb) * n, (s & mc) * n
-            for q in range(n):
-                rlo[o, so + q], rhi[o, so + q] = i_square(rlo[a, sa + q], rhi[a, sa + q])
-    elif op == EXP:
-        for s in range(8):
-            if (s & ~mo) != 0:
-                continue
-            so, sa, sb, sc = s * n, (s & ma) * n, (s & mb) * n, (s & mc) * n
-            for q in range(n):
-                rlo[o, so + q], rhi[o, so + q] = i_exp(rlo[a, sa + q], rhi[a, sa + q])
-    elif op == SIN:
-        for s in range(8):
-            if (s & ~mo) != 0:
-                continue
-            so, sa, sb, sc = s * n, (s & ma) * n, (s & mb) * n, (s & mc) * n
-            for q in range(n):
-                rlo[o, so + q], rhi[o, so + q] = i_sin(rlo[a, sa + q], rhi[a, sa + q])
-    elif op == COS:
-        for s in range(8):
-            if (s & ~mo) != 0:
-                continue
-            so, sa, sb, sc = s * n, (s & ma) * n, (s & mb) * n, (s & mc) * n
-            for q in range(n):
-                rlo[o, so + q], rhi[o, so + q] = i_cos(rlo[a, sa + q], rhi[a, sa + q])
-    elif op == TAN:
-        for s in range(8):
-            if (s & ~mo) != 0:
-                continue
-            so, sa, sb, sc = s * n, (s & ma) * n, (s & mb) * n, (s & mc) * n
-            for q in range(n):
-                rlo[o, so + q], rhi[o, so + q] = i_tan(rlo[a, sa + q], rhi[a, sa + q])
-    elif op == ATAN:
-        for s in range(8):
-            if (s & ~mo) != 0:
-                continue
-            so, sa, sb, sc = s * n, (s & ma) * n, (s & mb) * n, (s & mc) * n
-            for q in range(n):
-                rlo[o, so + q], rhi[o, so + q] = i_atan(rlo[a, sa + q], rhi[a, sa + q])
-    elif op == FLOOR:
-        for s in range(8):
-            if (s & ~mo) != 0:
-                continue
-            so, sa, sb, sc = s * n, (s & ma) * n, (s & mb) * n, (s & mc) * n
-            for q in range(n):
-                rlo[o, so + q], rhi[o, so + q] = i_floor(rlo[a, sa + q], rhi[a, sa + q])
-    elif op == ADD:
-        for s in range(8):
-            if (s & ~mo) != 0:
-                continue
-            so, sa, sb, sc = s * n, (s & ma) * n, (s & mb) * n, (s & mc) * n
-            for q in range(n):
-                rlo[o, so + q], rhi[o, so + q] = i_add(rlo[a, sa + q], rhi[a, sa + q], rlo[b,
-                                                       sb + q], rhi[b, sb + q])
-    elif op == SUB:
-        for s in range(8):
-            if (s & ~mo) != 0:
-                continue
-            so, sa, sb, sc = s * n, (s & ma) * n, (s & mb) * n, (s & mc) * n
-            for q in range(n):
-                rlo[o, so + q], rhi[o, so + q] = i_sub(rlo[a, sa + q], rhi[a, sa + q], rlo[b,
-                                                       sb + q], rhi[b, sb + q])
-    elif op == MUL:
-        for s in range(8):
-            if (s & ~mo) != 0:
-                continue
-            so, sa, sb, sc = s * n, (s & ma) * n, (s & mb) * n, (s & mc) * n
-            for q in range(n):
-                rlo[o, so + q], rhi[o, so + q] = i_mul(rlo[a, sa + q], rhi[a, sa + q], rlo[b,
-                                                       sb + q], rhi[b, sb + q])
-    elif op == DIV:
-        for s in range(8):
-            if (s & ~mo) != 0:
-                continue
-            so, sa, sb, sc = s * n, (s & ma) * n, (s & mb) * n, (s & mc) * n
-            for q in range(n):
-                rlo[o, so + q], rhi[o, so + q] = i_div(rlo[a, sa + q], rhi[a, sa + q], rlo[b,
-                                                       sb + q], rhi[b, sb + q])
-    elif op == HYPOT:
-        for s in range(8):
-            if (s & ~mo) != 0:
-                continue
-            so, sa, sb, sc = s * n, (s & ma) * n, (s & mb) * n, (s & mc) * n
-            for q in range(n):
-                rlo[o, so + q], rhi[o, so + q] = i_hypot(rlo[a, sa + q], rhi[a, sa + q], rlo[b,
-                                                         sb + q], rhi[b, sb + q])
-    elif op == ATAN2:
-        for s in range(8):
-            if (s & ~mo) != 0:
-                continue
-            so, sa, sb, sc = s * n, (s & ma) * n, (s & mb) * n, (s & mc) * n
-            for q in range(n):
-                rlo[o, so + q], rhi[o, so + q] = i_atan2(rlo[a, sa + q], rhi[a, sa + q], rlo[b,
-                                                         sb + q], rhi[b, sb + q])
-    elif op == RADIUS:
-        for s in range(8):
-            if (s & ~mo) != 0:
-                continue
-            so, sa, sb, sc = s * n, (s & ma) * n, (s & mb) * n, (s & mc) * n
-            for q in range(n):
-                rlo[o, so + q], rhi[o, so + q] = i_radius(rlo[a, sa + q], rhi[a, sa + q],
-                                                          rlo[b, sb + q], rhi[b, sb + q],
-                                                          rlo[c, sc + q], rhi[c, sc + q])
-    elif op == ELEVATION:
-        for s in range(8):
-            if (s & ~mo) != 0:
-                continue
-            so, sa, sb, sc = s * n, (s & ma) * n, (s & mb) * n, (s & mc) * n
-            for q in range(n):
-                rlo[o, so + q], rhi[o, so + q] = i_elevation(rlo[a, sa + q], rhi[a, sa + q],
-                                                             rlo[b, sb + q], rhi[b, sb + q],
-                                                             rlo[c, sc + q], rhi[c, sc + q])
-    elif op == PERIODIC_ANGLE:
-        for s in range(8):
-            if (s & ~mo) != 0:
-                continue
-            so, sa, sb, sc = s * n, (s & ma) * n, (s & mb) * n, (s & mc) * n
-            for q in range(n):
-                rlo[o, so + q], rhi[o, so + q] = i_periodic_angle(rlo[a, sa + q], rhi[a,
-                                                                  sa + q], rlo[b, sb + q],
-                                                                  rhi[b, sb + q], p0 != 0.0,
-                                                                  p1, p2)
-    elif op == POWI:
-        for s in range(8):
-            if (s & ~mo) != 0:
-                continue
-            so, sa, sb, sc = s * n, (s & ma) * n, (s & mb) * n, (s & mc) * n
-            for q in range(n):
-                rlo[o, so + q], rhi[o, so + q] = i_powi(rlo[a, sa + q], rhi[a, sa + q],
-                                                        int(p0))
-    elif op == SQRT:
-        for s in range(8):
-            if (s & ~mo) != 0:
-                continue
-            so, sa, sb, sc = s * n, (s & ma) * n, (s & mb) * n, (s & mc) * n
-            for q in range(n):
-                rlo[o, so + q], rhi[o, so + q], out_of_domain = i_sqrt(rlo[a, sa + q], rhi[a,
-                                                                 sa + q])
-                outside[so + q] = out_of_domain
-    elif op == LOG:
-        for s in range(8):
-            if (s & ~mo) != 0:
-                continue
-            so, sa, sb, sc = s * n, (s & ma) * n, (s & mb) * n, (s & mc) * n
-            for q in range(n):
-                rlo[o, so + q], rhi[o, so + q], out_of_domain = i_log(rlo[a, sa + q], rhi[a,
-                                                                      sa + q])
-                outside[so + q] = out_of_domain
-    elif op == ASIN:
-        for s in range(8):
-            if (s & ~mo) != 0:
-                continue
-            so, sa, sb, sc = s * n, (s & ma) * n, (s & mb) * n, (s & mc) * n
-            for q in range(n):
-                rlo[o, so + q], rhi[o, so + q], out_of_domain = i_asin(rlo[a, sa + q], rhi[a,
-                                                                 sa + q])
-                outside[so + q] = out_of_domain
-    elif op == ACOS:
-        for s in range(8):
-            if (s & ~mo) != 0:
-                continue
-            so, sa, sb, sc = s * n, (s & ma) * n, (s & mb) * n, (s & mc) * n
-            for q in range(n):
-                rlo[o, so + q], rhi[o, so + q], out_of_domain = i_acos(rlo[a, sa + q], rhi[a,
-                                                                 sa + q])
-                outside[so + q] = out_of_domain
-    elif op == POWR:
-        for s in range(8):
-            if (s & ~mo) != 0:
-                continue
-            so, sa, sb, sc = s * n, (s & ma) * n, (s & mb) * n, (s & mc) * n
-            for q in range(n):
-                rlo[o, so + q], rhi[o, so + q], out_of_domain = i_powr(rlo[a, sa + q], rhi[a,
-                                                                 sa + q], p0)
-                outside[so + q] = out_of_domain
