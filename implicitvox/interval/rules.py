@@ -55,10 +55,26 @@ __all__ = [
     "i_radius", "i_distance", "i_elevation", "i_periodic_angle", "COMPILE",
 ]
 
-#: how every compiled function of the kernel is compiled: cached on disk (a
-#: read-only install compiles in memory instead), releasing the GIL, numpy's
-#: error model (no exception on a division by zero)
-COMPILE = dict(cache=True, nogil=True, error_model="numpy")
+def _probe() -> int:
+    return 0
+
+
+def _cache_available() -> bool:
+    """Can Numba cache compiled code for this package? (Beside the sources, in the
+    user's cache directory, or in ``NUMBA_CACHE_DIR``; Numba raises ``RuntimeError``
+    at decoration when it finds no writable place, as in a read-only install
+    under a read-only home.)"""
+    try:
+        njit(cache=True)(_probe)
+    except RuntimeError:
+        return False
+    return True
+
+
+#: how every compiled function of the kernel is compiled: cached on disk where
+#: Numba finds a writable place (else compiled in memory on every first use),
+#: releasing the GIL, numpy's error model (no exception on a division by zero)
+COMPILE = dict(cache=_cache_available(), nogil=True, error_model="numpy")
 
 T = TRANSCENDENTAL_ULPS
 P = POW_ULPS

@@ -166,3 +166,31 @@ def test_choices_are_those_of_settle():
     evaluate_intervals(tape, tuple(lo), tuple(hi), choices=expected)
     np.testing.assert_array_equal(got, expected)
     assert len(np.unique(got)) == 3            # every kind of choice is exercised
+
+
+def test_a_read_only_install_compiles_in_memory(tmp_path):
+    """Where Numba can write no cache (the package's ``__pycache__`` folders and the
+    user's cache unwritable), the kernel still imports, uncached, and runs."""
+    import shutil
+    import subprocess
+    import sys
+    from pathlib import Path
+    root = Path(__file__).resolve().parents[2]
+    shutil.copytree(root / "implicitvox", tmp_path / "implicitvox",
+                    ignore=shutil.ignore_patterns("__pycache__"))
+    for folder in (tmp_path / "implicitvox").rglob("*"):
+        if folder.is_dir():
+            (folder / "__pycache__").write_text("not a folder: nothing can be cached here")
+    (tmp_path / "implicitvox" / "__pycache__").write_text("not a folder")
+    code = ("import numpy as np\n"
+            "from implicitvox.interval import rules\n"
+            "assert rules.COMPILE['cache'] is False, rules.COMPILE\n"
+            "lo, hi = rules.i_add(0.1, 0.1, 0.7, 0.7)\n"
+            "assert lo < 0.1 + 0.7 < hi\n"
+            "import implicitvox.octree.descend\n"
+            "print('ok')\n")
+    env = {"PATH": "/usr/bin:/bin", "HOME": "/dev/null", "XDG_CACHE_HOME": "/dev/null/cache",
+           "PYTHONPATH": str(tmp_path)}
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                          cwd=tmp_path, env=env, timeout=300)
+    assert done.returncode == 0 and done.stdout.strip() == "ok", done.stderr[-2000:]
