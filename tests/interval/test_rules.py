@@ -125,6 +125,14 @@ def test_rules_equal_the_array_kernels_bit_for_bit(name):
     hi = lo + rng.exponential(0.5, (3, n))
     lo[:, :50], hi[:, :50] = -np.inf, np.inf       # unbounded boxes too
     hi[:, 50:100] = np.inf
+    # and the values the property suites draw at their edges: zeros of both signs,
+    # subnormals, the largest floats, ends on the domains' bounds, points
+    special = np.array([0.0, -0.0, 5e-324, -5e-324, 1e-310, 1e300, -1e300, 1.7e308, -1.7e308,
+                        1.0, -1.0, np.pi, -np.pi, np.pi / 2, 1e15, -1e15])
+    k = len(special)
+    lo[:, 100:100 + k * k] = np.repeat(special, k)
+    hi[:, 100:100 + k * k] = np.maximum(np.tile(special, k), lo[:, 100:100 + k * k])
+    hi[:, 400:500] = lo[:, 400:500]                 # degenerate boxes
     param = PARAMS.get(name)
     flo, fhi = compiled.evaluate_boxes(compiled.encode(single_instruction(op, param)), lo, hi)
     with np.errstate(all="ignore"):
