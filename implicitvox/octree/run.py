@@ -25,11 +25,12 @@ MemoryError: meshing at (8, 8, 8) needs an estimated 2.00 GiB, over the budget o
 """
 from __future__ import annotations
 
+import os
 from dataclasses import dataclass, replace
 from typing import Any, Callable, Optional
 
 from .. import validate
-from ..parallel import plan_workers
+from ..parallel import WORKERS_VARIABLE, plan_workers
 from .budget import memory_budget, refuse_over_budget
 from .guard import MemoryGuard
 
@@ -73,9 +74,18 @@ class Run:
         return Run.of(max_memory=max_memory, progress=progress, workers=self.workers,
                       executor=self.executor)
 
-    def workers_for(self, work: float) -> int:
+    def workers_for(self, work: float, compiled: bool = False) -> int:
         """The workers for ``work`` units (estimated surface voxels or pairs):
-        :func:`implicitvox.parallel.plan_workers`; 1 means serial, here."""
+        :func:`implicitvox.parallel.plan_workers`; 1 means serial, here.
+
+        ``compiled``: the run is a subdivision on the compiled kernel, whose
+        default (no ``workers``, no executor, no ``$IMPLICITVOX_WORKERS``) is one
+        process for now: its parallel path restarts every subtree from the whole
+        tape and runs slower than one process (several times, on the level-3
+        Menger sponge at 512³); threads over subtrees are to replace it."""
+        if compiled and self.workers is None and self.executor is None \
+                and not os.environ.get(WORKERS_VARIABLE, "").strip():
+            return 1
         return plan_workers(self.workers, self.executor, work)
 
     def refuse(self, need: float, what: str) -> None:

@@ -27,6 +27,7 @@ from ..octree.grid import Grid, grid_of
 from ..octree.pilot import Estimate, estimate_surface
 from ..octree.run import Run
 from ..octree.store import Octree
+from ..octree.octants import runs_compiled
 from ..octree.subdivide import RECHECK
 from ..octree.surface import (SurfaceOptions, subdivide_voxels, surface_payload, unit_vectors,
                               voxel_normals)
@@ -181,7 +182,9 @@ def voxelize(shape: Any, resolution: Union[int, tuple[int, int, int], None] = No
         Processes to subdivide on (Stolte §5.2,
         :mod:`implicitvox.octree.subtrees`). Default: every core this
         process may use, or one (serial, in this process) for a run estimated
-        below :data:`implicitvox.parallel.MIN_PARALLEL_WORK` surface voxels.
+        below :data:`implicitvox.parallel.MIN_PARALLEL_WORK` surface voxels,
+        and, for now, for a model on the compiled kernel (one process is the
+        faster there: :meth:`implicitvox.octree.run.Run.workers_for`).
         The voxels, interior and normals are bit-identical for any number.
     executor : concurrent.futures.Executor or dask.distributed.Client, optional
         Run the pieces there instead (a Dask client: on its cluster;
@@ -214,7 +217,7 @@ def _run(source: ImplicitSource, grid: Grid, run: Run, start, interior_before) -
     """Estimate, refuse over the budget, then subdivide under a guard of the same budget."""
     shape, func, options = source.shape, source.func, source.options
     estimate, estimated_bytes = estimate_memory(func, grid, options.normals, options.prune)
-    workers = run.workers_for(estimate.voxels)
+    workers = run.workers_for(estimate.voxels, compiled=runs_compiled(func.tape, grid))
     per_voxel = bytes_per_voxel(options.normals)
     if workers > 1:
         estimated_bytes = parallel_bytes(estimate.voxels, per_voxel, working_bytes(grid),

@@ -278,6 +278,21 @@ def test_a_forked_child_has_its_own_pool_and_its_workers_die_with_it(tmp_path):
             pass
 
 
+def test_a_model_on_the_compiled_kernel_defaults_to_one_process(monkeypatch):
+    """For now (Run.workers_for): without workers, an executor or $IMPLICITVOX_WORKERS,
+    a model the compiled kernel takes runs in one process; one on the array path still
+    takes every core; an explicit count or the variable is obeyed."""
+    from implicitvox.parallel import plan
+    monkeypatch.setattr(plan, "MIN_PARALLEL_WORK", 1)
+    monkeypatch.setattr(plan, "available_cores", lambda: 2)
+    monkeypatch.delenv("IMPLICITVOX_WORKERS", raising=False)
+    assert iv.voxelize(examples.example("gear"), 48).metadata["workers"] == 1
+    assert iv.voxelize(examples.example("sinsin34"), 48).metadata["workers"] == 2
+    assert iv.voxelize(examples.example("gear"), 48, workers=2).metadata["workers"] == 2
+    monkeypatch.setenv("IMPLICITVOX_WORKERS", "2")
+    assert iv.voxelize(examples.example("gear"), 48).metadata["workers"] == 2
+
+
 def test_the_default_uses_every_core_when_it_pays(monkeypatch):
     from implicitvox.parallel import plan
     monkeypatch.setattr(plan, "MIN_PARALLEL_WORK", 1)
