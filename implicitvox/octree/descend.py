@@ -53,11 +53,12 @@ from ..expr.shape import AMBIGUOUS, EMPTY, FULL, Octants
 from ..interval.rules import COMPILE
 from .grid import Grid
 from .guard import MemoryGuard
-from .octants import (MAX_SIDE, RECHECK, Progress, Subdivision, TapeRuns, classify, pack,
-                      tighten, unpack)
+from .octants import (MAX_SIDE, RECHECK, ROOT_CODE, Progress, Subdivision, TapeRuns,
+                      classify_root, pack, tighten, unpack)
 from .. import batches
 
-__all__ = ["descend", "warm_up", "Descent", "Entries", "EntryFrontier", "BLOCK_PARENTS", "DERIVE_COST", "CHUNK"]
+__all__ = ["descend", "warm_up", "Descent", "Entries", "EntryFrontier", "BLOCK_PARENTS",
+           "DERIVE_COST", "CHUNK"]
 
 #: octants classified per step of the driver
 CHUNK = batches.FRONTIER
@@ -194,14 +195,10 @@ def descend(func: Function, grid: Grid, *, start: Optional[tuple[int, np.ndarray
     frontier = EntryFrontier()
     evaluated = 0
     if start is None:
-        root = np.zeros((1, 3), dtype=np.int32)
-        state = classify(func, grid, 0, root, exact_voxels if depth == 0 else exact, mean_value,
-                         run=run)
         evaluated = 1
-        if state[0] == FULL and interior:
-            interior_parts[0] = [pack(root)]
-        elif state[0] == AMBIGUOUS:
-            entry = Entries(pack(root), 0, 0 if leaf_level == 0 else -1)
+        if classify_root(func, grid, exact, exact_voxels, mean_value, interior, interior_parts,
+                         run):
+            entry = Entries(ROOT_CODE.copy(), 0, 0 if leaf_level == 0 else -1)
             if depth == 0:
                 surface.append(entry)
             else:
@@ -504,7 +501,8 @@ def _classify(xlo, xhi, ylo, yhi, zlo, zhi, limits, parents, tapes, prune,
                                 n_key += 1
                         if n_key * subtree >= derive_cost * count:
                             child_tapes[index] = prune_tape(
-                                t, key, np.int64(n_key), rows, tapes_, derivations, contents, keys, used,
+                                t, key, np.int64(n_key), rows, tapes_, derivations, contents,
+                                keys, used,
                                 masks, domain, fixed, scratch, kept)
                 if inside:
                     classified += 1

@@ -20,12 +20,14 @@ import numpy as np
 from ..eval.function import Function
 from ..eval.mean_value import mean_value_enclosure
 from ..eval.tape import Tape
-from ..expr.shape import AMBIGUOUS, Octants, takes_octants
+from ..expr.shape import AMBIGUOUS, FULL, Octants, takes_octants
 from . import morton
 from .grid import Grid
 from .level_dtype import interval_dtype
 
-__all__ = ["Subdivision", "TapeRuns", "runs_compiled", "COMPILED_MIN_LENGTH", "MAX_SIDE", "run_counts", "recount", "states", "classify", "tighten", "pack", "axes", "unpack",
+__all__ = ["Subdivision", "TapeRuns", "classify_root", "ROOT_CODE", "runs_compiled",
+           "COMPILED_MIN_LENGTH", "MAX_SIDE", "run_counts", "recount", "states", "classify",
+           "tighten", "pack", "axes", "unpack",
            "suspect_voxels", "inside_children", "Progress", "by_tapes", "RECHECK"]
 
 #: default strength of the recheck (:func:`suspect_voxels`; measured in
@@ -41,6 +43,23 @@ COMPILED_MIN_LENGTH = 16
 #: side (the recheck's grid, one level finer, included)
 MAX_SIDE = 1 << 15
 _SWEEPS = ("repeat", "repeat_polar")
+
+
+#: the root octant's Morton code (one entry)
+ROOT_CODE = np.zeros(1, dtype=np.uint64)
+
+
+def classify_root(func: Function, grid: Grid, exact, exact_voxels, mean_value: bool,
+                  interior: bool, interior_parts: dict, run: dict) -> bool:
+    """Classify the root octant, the first step of both subdivisions: a FULL root
+    goes into ``interior_parts`` (with ``interior``); returns whether it is
+    AMBIGUOUS (to be subdivided, or a surface voxel on a one-voxel grid, where
+    the voxels' exact test decides)."""
+    state = classify(func, grid, 0, np.zeros((1, 3), dtype=np.int32),
+                     exact_voxels if grid.depth == 0 else exact, mean_value, run=run)[0]
+    if state == FULL and interior:
+        interior_parts[0] = [ROOT_CODE.copy()]
+    return state == AMBIGUOUS
 
 
 def runs_compiled(tape: Tape, grid: Grid) -> bool:

@@ -41,8 +41,9 @@ from ..interval.float32 import outward_float32
 from ..eval.float32_tapes import supports_float32
 from ..expr.shape import AMBIGUOUS, FULL, Octants
 from .. import batches
-from .octants import (RECHECK, Progress, Subdivision, axes, by_tapes, classify, inside_children,
-                      pack, runs_compiled, states, suspect_voxels, tighten, unpack)
+from .octants import (RECHECK, ROOT_CODE, Progress, Subdivision, axes, by_tapes, classify,
+                      classify_root, inside_children, pack, runs_compiled, states,
+                      suspect_voxels, tighten, unpack)
 
 __all__ = ["subdivide", "Subdivision", "classify", "classify_children", "suspect_voxels",
            "recheck_voxels", "prunes_at", "CHUNK", "RECHECK", "PRUNE_EVERY", "PRUNE_MIN_BELOW",
@@ -307,17 +308,13 @@ def subdivide(func: Function, grid: Grid, *, start: Optional[tuple[int, np.ndarr
     frontier = Frontier()
     evaluated = 0
     if start is None:
-        root = np.zeros((1, 3), dtype=np.int32)
-        state = classify(func, grid, 0, root, exact_voxels if depth == 0 else exact, mean_value,
-                         run=run)
         evaluated = 1
-        if state[0] == FULL and interior:
-            interior_parts[0] = [pack(root)]
-        elif state[0] == AMBIGUOUS:
+        if classify_root(func, grid, exact, exact_voxels, mean_value, interior, interior_parts,
+                         run):
             if depth == 0:
-                surface.append((pack(root), base))
+                surface.append((ROOT_CODE.copy(), base))
             else:
-                frontier.push(0, pack(root), base, base if leaf_level == 0 else None)
+                frontier.push(0, ROOT_CODE.copy(), base, base if leaf_level == 0 else None)
     else:
         level0, coords0 = start
         frontier.push(level0, pack(coords0), base, base if level0 >= leaf_level else None)
