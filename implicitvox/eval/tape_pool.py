@@ -175,10 +175,36 @@ class TapePool:
         while used[USED_KEYS] + rows > len(self.keys):
             self.keys = _doubled(self.keys)
         while (used[USED_DERIVATIONS] + tapes) * 2 > len(self.derivations):
-            self.derivations = _rehashed(self.derivations)
+            self.derivations = _rehashed(self.derivations, 2 * len(self.derivations))
         while (used[USED_CONTENTS] + tapes) * 2 > len(self.contents):
-            self.contents = _rehashed(self.contents)
+            self.contents = _rehashed(self.contents, 2 * len(self.contents))
         used[FULL] = 0
+
+    def __getstate__(self) -> dict:
+        """The pool without its spare room (what is pickled and copied): the rows,
+        tapes and keys used, the hash tables rehashed into the least room that
+        keeps them at most half full (:meth:`grow` makes room again)."""
+        used = self.used
+        state = dict(self.__dict__)
+        state["rows"] = self.rows[:max(int(used[USED_ROWS]), 1)].copy()
+        state["tapes"] = self.tapes[:max(int(used[USED_TAPES]), 1)].copy()
+        state["keys"] = self.keys[:max(int(used[USED_KEYS]), 16)].copy()
+        state["derivations"] = _rehashed(self.derivations, _table_room(used[USED_DERIVATIONS]))
+        state["contents"] = _rehashed(self.contents, _table_room(used[USED_CONTENTS]))
+        for name in ("used", "scratch", "kept"):
+            state[name] = getattr(self, name).copy()
+        state["_tapes"] = {}
+        return state
+
+    def __setstate__(self, state: dict) -> None:
+        self.__dict__.update(state)
+
+    def copy(self) -> "TapePool":
+        """An independent pool with the same tapes, under the same indices (each
+        thread of a parallel run derives into its own)."""
+        twin = TapePool.__new__(TapePool)
+        twin.__setstate__(self.__getstate__())
+        return twin
 
     def arrays(self) -> tuple:
         """The arrays compiled code reads and writes, in :func:`prune_tape`'s order."""
@@ -227,10 +253,16 @@ def _doubled(a: np.ndarray) -> np.ndarray:
     return out
 
 
+def _table_room(entries: int) -> int:
+    """The least power of 2 (at least 16) that holds ``entries`` at most half full."""
+    return max(16, 1 << int(2 * int(entries)).bit_length())
+
+
 @njit(**COMPILE)
-def _rehashed(table):
-    """A hash table (column 0: the hash, 0 free) in twice the room."""
-    bigger = np.zeros((2 * table.shape[0], table.shape[1]), dtype=np.int64)
+def _rehashed(table, room):
+    """A hash table (column 0: the hash, 0 free) in ``room`` rows (a power of 2 with
+    room for every entry)."""
+    bigger = np.zeros((room, table.shape[1]), dtype=np.int64)
     mask = bigger.shape[0] - 1
     for k in range(table.shape[0]):
         h = table[k, 0]

@@ -84,8 +84,9 @@ def mesh(shape: Any, tolerance: Optional[float] = None,
         (:func:`implicitvox.octree.subtrees.subdivide_in_parallel`); the
         refinement and the contouring run here. The mesh is the same, bit for
         bit, for any number. Default: every core this process may use, one for
-        a small run and, for now, for a model on the compiled kernel (as
-        :func:`implicitvox.voxelize`).
+        a small run and, for now, for a model on the compiled kernel (its
+        subdivision is a small share of the run:
+        :meth:`implicitvox.octree.run.Run.workers_for`).
     executor : concurrent.futures.Executor or dask.distributed.Client, optional
         Run the subdivision there instead.
 
@@ -151,7 +152,7 @@ def mesh_grid(shape: Any, grid: Grid, run: Run, *, refine: int = REFINE,
     run.refuse(need, f"{what} (~{estimated:,} cells; {estimate.explained()})")
     guard = run.guard(what, BYTES_PER_CELL, estimated=estimated)
     t0 = time.perf_counter()
-    workers = run.workers_for(estimate.voxels, compiled=runs_compiled(func.tape, grid))
+    workers = run.workers_for(estimate.voxels, default_serial=runs_compiled(func.tape, grid))
     split = None
     if workers > 1 or run.executor is not None:
         split = subdivide_in_parallel(shape, func, grid, SurfaceOptions(prune=prune),

@@ -53,8 +53,8 @@ from ..expr.shape import AMBIGUOUS, EMPTY, FULL, Octants
 from ..interval.rules import COMPILE
 from .grid import Grid
 from .guard import MemoryGuard
-from .octants import (MAX_SIDE, RECHECK, ROOT_CODE, Progress, Subdivision, TapeRuns,
-                      classify_root, pack, tighten, unpack)
+from .octants import (MAX_SIDE, RECHECK, ROOT_CODE, Progress, PrunedTapes, Subdivision,
+                      TapeRuns, classify_root, pack, tighten, unpack)
 from .. import batches
 
 __all__ = ["descend", "warm_up", "Descent", "Entries", "EntryFrontier", "BLOCK_PARENTS",
@@ -171,9 +171,16 @@ def descend(func: Function, grid: Grid, *, start: Optional[tuple[int, np.ndarray
             interior: bool = False, exact=None, progress=None, chunk: int = CHUNK,
             mean_value: bool = False, exact_voxels=None, recheck: float = RECHECK,
             guard: Optional[MemoryGuard] = None, prune: bool = True,
-            leaf_level: Optional[int] = None, until_level: Optional[int] = None) -> Subdivision:
+            leaf_level: Optional[int] = None, until_level: Optional[int] = None,
+            start_tapes: Optional[PrunedTapes] = None) -> Subdivision:
     """:func:`implicitvox.octree.subdivide.subdivide` on the compiled kernel: the same
     options and result, every octant with its own tape (see the module).
+
+    ``start_tapes``: the pool tapes of the ``start`` octants (a head run's
+    :attr:`~implicitvox.octree.octants.Subdivision.pending_tapes`), which are
+    then continued on their pruned tapes, in a copy of that pool; with
+    ``until_level``, the result's ``pending_tapes`` are those of its pending
+    octants (in its pool).
 
     The driver is the array subdivision's (Stolte §2 on a frontier of chunks,
     deepest level first, so memory stays bounded by ``8 * chunk * depth``
@@ -186,7 +193,12 @@ def descend(func: Function, grid: Grid, *, start: Optional[tuple[int, np.ndarray
     per_step = max(1, chunk // 8)
     if exact_voxels is None:
         exact_voxels = exact
-    pool = TapePool(func.tape)
+    if start_tapes is not None:
+        if start is None or len(start_tapes) != len(start[1]):
+            raise ValueError("start_tapes must give one tape per start octant")
+        pool = start_tapes.pool.copy()
+    else:
+        pool = TapePool(func.tape)
     descent = Descent(pool, grid)
     fine = Descent(pool, grid.finer(1)) if recheck > 0.0 and exact_voxels is None else None
     run: dict = {}          # the exact test's scratch space for this subdivision
@@ -205,10 +217,12 @@ def descend(func: Function, grid: Grid, *, start: Optional[tuple[int, np.ndarray
                 frontier.push(0, entry)
     else:
         level0, coords0 = start
-        frontier.push(level0, Entries(pack(coords0), 0, 0 if level0 >= leaf_level else -1))
+        tapes0 = 0 if start_tapes is None else start_tapes.tapes
+        frontier.push(level0, Entries(pack(coords0), tapes0,
+                                      tapes0 if level0 >= leaf_level else -1))
     meter = Progress(progress, depth)
     suspects: list[Entries] = []
-    held_back: list[np.ndarray] = []     # octants reaching until_level
+    held_back: list[Entries] = []        # octants reaching until_level
     pending = 0
     kept = sum(len(e) for e in surface)
     held = len(frontier)
@@ -277,7 +291,7 @@ def descend(func: Function, grid: Grid, *, start: Optional[tuple[int, np.ndarray
             surface.append(entries)
             kept += len(entries)
         elif child == until_level:
-            held_back.append(entries.codes)
+            held_back.append(entries)
         else:
             frontier.push(child, entries)
             held += len(entries)
@@ -296,6 +310,8 @@ def descend(func: Function, grid: Grid, *, start: Optional[tuple[int, np.ndarray
         else np.zeros(0, dtype=np.int64)
     ids = leaf[starts]
     counts = np.diff(np.append(starts, len(leaf)))
+    held = Entries.join(held_back) if held_back else None
+    order = np.argsort(held.codes) if held is not None else None
     return Subdivision(
         codes=found.codes,
         interior={lvl: unpack(np.sort(np.concatenate(parts)))   # Morton order: any schedule
@@ -303,8 +319,8 @@ def descend(func: Function, grid: Grid, *, start: Optional[tuple[int, np.ndarray
         evaluated=evaluated,
         tapes=TapeRuns(counts, lambda i: pool.tape(int(ids[i]))),
         tapes_built=len(pool) - 1,
-        pending=np.sort(np.concatenate(held_back)) if held_back else
-        np.zeros(0, dtype=np.uint64))
+        pending=held.codes[order] if held is not None else np.zeros(0, dtype=np.uint64),
+        pending_tapes=PrunedTapes(pool, held.tapes[order]) if held is not None else None)
 
 
 class Descent:

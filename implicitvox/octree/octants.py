@@ -25,7 +25,7 @@ from . import morton
 from .grid import Grid
 from .level_dtype import interval_dtype
 
-__all__ = ["Subdivision", "TapeRuns", "classify_root", "ROOT_CODE", "runs_compiled",
+__all__ = ["Subdivision", "PrunedTapes", "TapeRuns", "classify_root", "ROOT_CODE", "runs_compiled",
            "COMPILED_MIN_LENGTH", "MAX_SIDE", "run_counts", "recount", "states", "classify",
            "tighten", "pack", "axes", "unpack",
            "suspect_voxels", "inside_children", "Progress", "by_tapes", "RECHECK"]
@@ -128,6 +128,24 @@ class TapeRuns(Sequence):
         return TapeRuns(counts[kept], lambda i: self.tape(int(kept[i])))
 
 
+@dataclass(frozen=True)
+class PrunedTapes:
+    """The tapes of some octants in a pool of the compiled kernel: octant ``i`` has
+    pool tape ``tapes[i]`` of ``pool`` (a :class:`~implicitvox.eval.tape_pool.TapePool`,
+    which a subdivision continuing from them copies, never changes)."""
+
+    pool: Any
+    #: int32, one per octant
+    tapes: np.ndarray
+
+    def __len__(self) -> int:
+        return len(self.tapes)
+
+    def take(self, which: Any) -> "PrunedTapes":
+        """The tapes of the octants ``which`` (an index, slice or mask)."""
+        return PrunedTapes(self.pool, self.tapes[which])
+
+
 def run_counts(runs: Sequence) -> np.ndarray:
     """Voxels per run of ``runs`` (a list of ``(count, tape)`` or :class:`TapeRuns`),
     without building a tape."""
@@ -163,6 +181,9 @@ class Subdivision:
     #: with ``until_level``: the AMBIGUOUS octants reached at that level (Morton
     #: codes, sorted), not subdivided further: the subtrees a parallel run hands out
     pending: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=np.uint64))
+    #: on the compiled kernel: the pruned tapes of :attr:`pending` (a subdivision
+    #: continued from them with ``start_tapes`` evaluates what this one would have)
+    pending_tapes: Optional["PrunedTapes"] = None
 
     @property
     def surface(self) -> np.ndarray:

@@ -74,16 +74,15 @@ class Run:
         return Run.of(max_memory=max_memory, progress=progress, workers=self.workers,
                       executor=self.executor)
 
-    def workers_for(self, work: float, compiled: bool = False) -> int:
+    def workers_for(self, work: float, default_serial: bool = False) -> int:
         """The workers for ``work`` units (estimated surface voxels or pairs):
         :func:`implicitvox.parallel.plan_workers`; 1 means serial, here.
 
-        ``compiled``: the run is a subdivision on the compiled kernel, whose
+        ``default_serial``: the caller's parallel path does not pay yet, so its
         default (no ``workers``, no executor, no ``$IMPLICITVOX_WORKERS``) is one
-        process for now: its parallel path restarts every subtree from the whole
-        tape and runs slower than one process (several times, on the level-3
-        Menger sponge at 512³); threads over subtrees are to replace it."""
-        if compiled and self.workers is None and self.executor is None \
+        worker (meshing a model on the compiled kernel: its subdivision is a
+        small share of the run, and the pieces' pruned tapes are rebuilt in Python)."""
+        if default_serial and self.workers is None and self.executor is None \
                 and not os.environ.get(WORKERS_VARIABLE, "").strip():
             return 1
         return plan_workers(self.workers, self.executor, work)

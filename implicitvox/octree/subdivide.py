@@ -41,8 +41,8 @@ from ..interval.float32 import outward_float32
 from ..eval.float32_tapes import supports_float32
 from ..expr.shape import AMBIGUOUS, FULL, Octants
 from .. import batches
-from .octants import (RECHECK, ROOT_CODE, Progress, Subdivision, axes, by_tapes, classify,
-                      classify_root, inside_children, pack, runs_compiled, states,
+from .octants import (RECHECK, ROOT_CODE, Progress, PrunedTapes, Subdivision, axes, by_tapes,
+                      classify, classify_root, inside_children, pack, runs_compiled, states,
                       suspect_voxels, tighten, unpack)
 
 __all__ = ["subdivide", "Subdivision", "classify", "classify_children", "suspect_voxels",
@@ -242,7 +242,8 @@ def subdivide(func: Function, grid: Grid, *, start: Optional[tuple[int, np.ndarr
               mean_value: bool = False, exact_voxels=None,
               recheck: float = RECHECK, guard: Optional[MemoryGuard] = None,
               prune: bool = True, leaf_level: Optional[int] = None,
-              until_level: Optional[int] = None) -> Subdivision:
+              until_level: Optional[int] = None,
+              start_tapes: Optional[PrunedTapes] = None) -> Subdivision:
     """Classify octants from the root (or from ``start``) down to the voxels.
 
     Parameters
@@ -286,13 +287,19 @@ def subdivide(func: Function, grid: Grid, *, start: Optional[tuple[int, np.ndarr
         subdivided. Each is an independent subtree; continuing from them
         (``start``) gives, together, exactly the serial run's voxels and
         interior (a box's state depends on the box alone).
+    start_tapes : PrunedTapes, optional
+        The pruned tapes of the ``start`` octants on the compiled kernel (a
+        head run's :attr:`Subdivision.pending_tapes`): the subtrees continue on
+        them instead of the whole tape (the same result, sooner). The array
+        evaluator, which keeps no tapes between runs, ignores them.
     """
     if runs_compiled(func.tape, grid):
         from .descend import descend     # (loads Numba: not at import)
         return descend(func, grid, start=start, interior=interior, exact=exact,
                        progress=progress, chunk=chunk, mean_value=mean_value,
                        exact_voxels=exact_voxels, recheck=recheck, guard=guard, prune=prune,
-                       leaf_level=leaf_level, until_level=until_level)
+                       leaf_level=leaf_level, until_level=until_level,
+                       start_tapes=start_tapes)
     depth = grid.depth
     leaf_level = depth if leaf_level is None else leaf_level
     per_step = max(1, chunk // 8)

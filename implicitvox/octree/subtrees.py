@@ -1,20 +1,26 @@
-"""``voxelize`` on several processes or a Dask cluster (Stolte §5.2, Fig. 10).
+"""``voxelize`` on several threads, processes or a Dask cluster (Stolte §5.2, Fig. 10).
 
 Stolte's master subdivides the top of the octree and hands the ambiguous
 subtrees to workers, which subdivide them to the voxels; the master merges
 what they found. Here:
 
 1. The master runs the subdivision down to a split level where the
-   AMBIGUOUS octants number at least :data:`OCTANTS_PER_PIECE` per piece (or
-   :data:`MIN_LEVELS_BELOW` levels above the voxels)
-   (``until_level``, :class:`~implicitvox.octree.subdivide.Subdivision`
-   ``.pending``), keeping the FULL octants it met on the way.
+   AMBIGUOUS octants number at least :data:`OCTANTS_PER_PIECE` per piece
+   (:data:`OCTANTS_PER_THREAD_PIECE` on threads), or :data:`MIN_LEVELS_BELOW`
+   levels above the voxels (``until_level``,
+   :class:`~implicitvox.octree.subdivide.Subdivision` ``.pending``), keeping
+   the FULL octants it met on the way. On the compiled kernel the pending
+   octants keep their pruned tapes (``.pending_tapes``: a pool of tapes and
+   each octant's), and the workers continue on them.
 2. Those octants, in Morton order, are cut into contiguous runs
    (:func:`implicitvox.parallel.pieces_for`: from 2 to ``PIECES_PER_WORKER``
    per worker, by the estimated voxels; neighbouring subtrees share pruned
    tapes, and the queue balances uneven runs) and farmed out
-   (:func:`implicitvox.parallel.farm`). The shape, its compiled tape, the grid
-   and the options travel once per worker (a :class:`SubtreeJob`).
+   (:func:`implicitvox.parallel.farm`): to threads of this process for a
+   model on the compiled kernel (whose subdivision releases the GIL), else
+   to processes. The shape, its compiled tape, the grid, the options and the
+   head's pool of tapes (without its spare room) travel once per worker (a
+   :class:`SubtreeJob`); each piece continues in its own copy of the pool.
 3. Each worker continues the subdivision from its octants
    (:func:`~implicitvox.octree.surface.subdivide_voxels` with ``start``),
    maps sub-voxels back, computes the normals of its voxels, sorts them, and
@@ -45,6 +51,7 @@ from ..expr.shape import exact_classifier, voxel_classifier
 from . import morton
 from .grid import Grid
 from .guard import MemoryGuard
+from .octants import PrunedTapes, runs_compiled
 from .store import Octree, subtree_masks
 from .run import Run
 from .subdivide import Subdivision
@@ -53,12 +60,15 @@ from .surface import SurfaceOptions, subdivide_voxels, surface_payload
 
 __all__ = ["SubtreeJob", "SubtreeResult", "ParallelSubdivision", "subdivide_in_parallel",
            "parallel_bytes",
-           "OCTANTS_PER_PIECE", "MIN_LEVELS_BELOW"]
+           "OCTANTS_PER_PIECE", "OCTANTS_PER_THREAD_PIECE", "MIN_LEVELS_BELOW"]
 
 #: the split level is the first with at least this many AMBIGUOUS octants per piece:
 #: a piece starts with full-sized batches (measured in bench_parallel.py: 4 octants
 #: per piece made the workers' first levels a string of small numpy calls)
 OCTANTS_PER_PIECE = 512
+#: ...or this many on threads (compiled kernel): a piece is not pickled, and starts on
+#: the head's pruned tapes (bench_parallel.py: 128 against 512 on three CSG models)
+OCTANTS_PER_THREAD_PIECE = 128
 #: ...and leaves at least this many levels to the workers (else the run is serial)
 MIN_LEVELS_BELOW = 3
 
@@ -90,9 +100,12 @@ class SubtreeJob(Job):
     """The subdivision of subtrees at ``level``, shared by every piece of one run."""
 
     def __init__(self, shape: Any, func: Function, grid: Grid, options: SurfaceOptions,
-                 level: int, budget: int, per_voxel: int, what: str, tapes: bool = False):
+                 level: int, budget: int, per_voxel: int, what: str, tapes: bool = False,
+                 pool: Any = None):
         super().__init__()
         self.tapes = tapes
+        #: the head's pool of pruned tapes (compiled kernel), which the pieces' tapes index
+        self.pool = pool
         self.shape, self.func, self.grid, self.options = shape, func, grid, options
         self.level, self.budget, self.per_voxel, self.what = level, int(budget), per_voxel, what
 
@@ -101,13 +114,16 @@ class SubtreeJob(Job):
         """The shape's exact box and voxel tests (closures: built in the worker)."""
         return exact_classifier(self.shape), voxel_classifier(self.shape)
 
-    def run(self, piece: np.ndarray) -> SubtreeResult:
-        """Subdivide the subtrees rooted at octants ``piece`` (Morton codes at
-        :attr:`level`) to the voxels."""
-        coords = morton.decode(piece).astype(np.int32)
+    def run(self, piece: tuple) -> SubtreeResult:
+        """Subdivide the subtrees rooted at octants ``piece = (codes, tapes)``
+        (Morton codes at :attr:`level`; their pool tapes, or None) to the voxels."""
+        codes, tapes = piece
+        coords = morton.decode(codes).astype(np.int32)
         guard = MemoryGuard(self.budget, f"{self.what} (a worker)", self.per_voxel)
         result = subdivide_voxels(self.func, self.grid, self.options, self.prepared_exact,
-                                  start=(self.level, coords), guard=guard)
+                                  start=(self.level, coords), guard=guard,
+                                  start_tapes=None if tapes is None else
+                                  PrunedTapes(self.pool, tapes))
         payload = surface_payload(self.func, self.grid, result, self.options.normals)
         interior = {lvl: morton.encode(c) for lvl, c in result.interior.items()}
         count = len(result.codes)
@@ -139,6 +155,8 @@ class ParallelSubdivision:
     tree: Optional[Octree]
     #: surface voxels
     count: int
+    #: where the pieces ran: "threads", "processes" or "executor"
+    on: str = "processes"
 
 
 def parallel_bytes(voxels: int, per_voxel: int, working: int, workers: int) -> int:
@@ -178,7 +196,10 @@ def subdivide_in_parallel(shape: Any, func: Function, grid: Grid, options: Surfa
     exact = (exact_classifier(shape), voxel_classifier(shape))
     pieces_wanted = PIECES_PER_WORKER * workers if estimated is None else \
         pieces_for(workers, estimated, executor)
+    threads = executor is None and runs_compiled(func.tape, grid.finer(s) if s else grid)
+    per_piece = OCTANTS_PER_THREAD_PIECE if threads else OCTANTS_PER_PIECE
     heads: list[Subdivision] = []
+    seeds = None                    # the pruned tapes of the pending octants (compiled kernel)
     if start is not None:
         level, pending = start[0], morton.encode(start[1])
     else:
@@ -190,15 +211,17 @@ def subdivide_in_parallel(shape: Any, func: Function, grid: Grid, options: Surfa
             level += 1
             head = subdivide_voxels(func, grid, options, exact, guard=guard, until_level=level,
                                     start=None if pending is None else
-                                    (level - 1, morton.decode(pending).astype(np.int32)))
+                                    (level - 1, morton.decode(pending).astype(np.int32)),
+                                    start_tapes=seeds)
             heads.append(head)
-            pending = head.pending
-            if len(pending) >= OCTANTS_PER_PIECE * pieces_wanted or not len(pending) \
+            pending, seeds = head.pending, head.pending_tapes
+            if len(pending) >= per_piece * pieces_wanted or not len(pending) \
                     or level == deepest:
                 break
     ranges = split_evenly(len(pending), pieces_wanted)
     job = SubtreeJob(shape, func, grid, options, level, budget // (workers + 1), per_voxel, what,
-                     tapes)
+                     tapes, pool=None if seeds is None else seeds.pool)
+    pieces = [(pending[a:b], None if seeds is None else seeds.tapes[a:b]) for a, b in ranges]
     runs: list = []
     codes: list[np.ndarray] = []
     payload: dict[str, list] = {}
@@ -210,9 +233,9 @@ def subdivide_in_parallel(shape: Any, func: Function, grid: Grid, options: Surfa
             interior.setdefault(lvl, []).append(morton.encode(c))
     kept = 0
     parts: dict[int, SubtreeResult] = {}          # by piece: merged in Morton order
-    for index, part in farm(job, [pending[a:b] for a, b in ranges], workers=workers,
-                            executor=executor, weights=[b - a for a, b in ranges],
-                            progress=run.progress, what=what):
+    for index, part in farm(job, pieces, workers=workers, executor=executor,
+                            weights=[b - a for a, b in ranges], progress=run.progress,
+                            what=what, threads=threads):
         parts[index] = part
         if tapes:                                  # else the codes stay in the workers
             codes.append(part.codes)
@@ -238,4 +261,5 @@ def subdivide_in_parallel(shape: Any, func: Function, grid: Grid, options: Surfa
     if not tapes:
         tree = Octree.from_subtrees(grid.depth, min(level, grid.depth),
                                     [p.octree for p in ordered], merged)
-    return ParallelSubdivision(result, merged, tree, kept)
+    on = "executor" if executor is not None else "threads" if threads else "processes"
+    return ParallelSubdivision(result, merged, tree, kept, on)

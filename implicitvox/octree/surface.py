@@ -19,7 +19,7 @@ from . import morton
 from .grid import Grid
 from .guard import MemoryGuard
 from .morton import MAX_BITS
-from .octants import recount, run_counts
+from .octants import PrunedTapes, recount, run_counts
 from .subdivide import RECHECK, Subdivision, subdivide
 
 __all__ = ["SurfaceOptions", "subdivide_voxels", "interior_from_subvoxels", "voxel_normals",
@@ -99,20 +99,23 @@ def surface_payload(func: Function, grid: Grid, result: Subdivision, normals: bo
 
 def subdivide_voxels(func: Function, grid: Grid, options: SurfaceOptions, exact: tuple,
                      progress: Any = None, start: Any = None, guard: Optional[MemoryGuard] = None,
-                     until_level: Optional[int] = None) -> Subdivision:
+                     until_level: Optional[int] = None,
+                     start_tapes: Optional[PrunedTapes] = None) -> Subdivision:
     """:func:`implicitvox.octree.subdivide.subdivide` with the voxelizer's
     ``options`` on ``grid``, or on ``grid.finer(subvoxel)`` mapped back to
     ``grid``'s voxels. ``exact``: the shape's box and voxel tests;
     ``until_level`` (at most ``grid.depth``) stops there and returns the
     pending subtrees (:attr:`Subdivision.pending`, levels of the grid
-    subdivided)."""
+    subdivided; their tapes in ``pending_tapes``, which ``start_tapes`` takes
+    back)."""
     s = options.subvoxel
     exact_boxes, exact_voxels = exact
     result = subdivide(func, grid.finer(s) if s else grid, start=start,
                        interior=options.interior, exact=exact_boxes, progress=progress,
                        mean_value=options.mean_value, exact_voxels=exact_voxels,
                        recheck=options.recheck, guard=guard, prune=options.prune,
-                       leaf_level=grid.depth, until_level=until_level)
+                       leaf_level=grid.depth, until_level=until_level,
+                       start_tapes=start_tapes)
     if not s:
         return result
     # the voxels holding them, each with the tape of one of its sub-voxels (all have the voxel's)

@@ -1,6 +1,6 @@
 """Hand a job's pieces to workers and yield their results as they complete.
 
-Three backends behind one generator, :func:`farm`:
+Four backends behind one generator, :func:`farm`:
 
 * ``workers=n`` (no executor): a ``ProcessPoolExecutor`` of ``n`` processes,
   forked (or, when this process runs other threads, started by a
@@ -8,6 +8,10 @@ Three backends behind one generator, :func:`farm`:
   kept for the next run (starting workers costs more than a small run); the
   job is pickled once into a file (in ``/dev/shm`` where there is one) that
   each worker reads on its first piece: it travels once per worker.
+* ``workers=n, threads=True``: ``n`` threads of this process, for a job whose
+  pieces run in compiled code that releases the GIL (the compiled
+  subdivision, :mod:`implicitvox.octree.descend`): nothing is pickled, the
+  pieces share the job as it is.
 * ``executor=`` a ``dask.distributed.Client``: a job larger than
   :data:`SCATTER_BYTES` pickled (a mesh's triangles) is ``scatter``-ed to
   every worker (``broadcast=True``) and each piece is a task reading it
@@ -42,7 +46,7 @@ import os
 import pickle
 import threading
 import time
-from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
+from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, ThreadPoolExecutor, wait
 from concurrent.futures.process import BrokenProcessPool
 from typing import Any, Callable, Iterator, Optional, Sequence
 
@@ -64,7 +68,7 @@ class WorkerError(RuntimeError):
 def farm(job: Job, pieces: Sequence[Any], *, workers: int = 2, executor: Any = None,
          weights: Optional[Sequence[float]] = None,
          progress: Optional[Callable[[float], Any]] = None,
-         what: str = "a parallel run") -> Iterator[tuple[int, Any]]:
+         what: str = "a parallel run", threads: bool = False) -> Iterator[tuple[int, Any]]:
     """Run ``job.run(piece)`` for every piece on workers; yield ``(index, result)``
     as each completes (in no fixed order).
 
@@ -75,7 +79,8 @@ def farm(job: Job, pieces: Sequence[Any], *, workers: int = 2, executor: Any = N
     pieces : sequence
         Small, picklable descriptions of independent work (subtrees).
     workers : int, default: 2
-        Processes of an own pool (ignored with ``executor``).
+        Processes of an own pool, or threads with ``threads`` (ignored with
+        ``executor``).
     executor : concurrent.futures.Executor or dask.distributed.Client, optional
         Where to run instead of an own pool.
     weights : sequence of float, optional
@@ -84,6 +89,9 @@ def farm(job: Job, pieces: Sequence[Any], *, workers: int = 2, executor: Any = N
         Called with the share of the weight completed, after each piece.
     what : str
         The run, for error messages ("voxelizing at (512, 512, 512)").
+    threads : bool, default: False
+        Run the pieces on ``workers`` threads of this process instead of
+        processes (without ``executor``).
 
     Raises
     ------
@@ -94,7 +102,9 @@ def farm(job: Job, pieces: Sequence[Any], *, workers: int = 2, executor: Any = N
         return
     weights = [1.0] * len(pieces) if weights is None else [float(w) for w in weights]
     total = sum(weights) or 1.0
-    if executor is None:
+    if executor is None and threads:
+        backend = _Threads(job, workers)
+    elif executor is None:
         backend = _OwnPool(job, workers)
     elif is_dask_client(executor):
         backend = _Dask(job, executor)
@@ -289,6 +299,29 @@ class _Futures(_Executor):
     def close(self) -> None:
         for future in self.futures:
             future.cancel()
+
+
+class _Threads(_Futures):
+    """Threads of this process, for the length of one run; the job runs as it is
+    (not installed: nothing of it outlives the run)."""
+
+    def __init__(self, job: Job, workers: int):
+        super().__init__(job, ThreadPoolExecutor(max(1, int(workers)),
+                                                 thread_name_prefix="implicitvox"))
+
+    def submit(self, piece):
+        future = self.executor.submit(self.job.run, piece)
+        self.futures.append(future)
+        return future
+
+    def finish(self) -> None:
+        self.executor.shutdown(wait=True)
+
+    def close(self) -> None:
+        """Cancel the pieces not started; those running finish in the background
+        (a thread cannot be stopped), their results dropped."""
+        super().close()
+        self.executor.shutdown(wait=False, cancel_futures=True)
 
 
 class _Dask:

@@ -27,7 +27,6 @@ from ..octree.grid import Grid, grid_of
 from ..octree.pilot import Estimate, estimate_surface
 from ..octree.run import Run
 from ..octree.store import Octree
-from ..octree.octants import runs_compiled
 from ..octree.subdivide import RECHECK
 from ..octree.surface import (SurfaceOptions, subdivide_voxels, surface_payload, unit_vectors,
                               voxel_normals)
@@ -179,12 +178,12 @@ def voxelize(shape: Any, resolution: Union[int, tuple[int, int, int], None] = No
         each voxel, about what the parts near it cost. The voxels, interior
         and normals are bit-identical with ``prune=False``.
     workers : int, optional
-        Processes to subdivide on (Stolte §5.2,
-        :mod:`implicitvox.octree.subtrees`). Default: every core this
-        process may use, or one (serial, in this process) for a run estimated
-        below :data:`implicitvox.parallel.MIN_PARALLEL_WORK` surface voxels,
-        and, for now, for a model on the compiled kernel (one process is the
-        faster there: :meth:`implicitvox.octree.run.Run.workers_for`).
+        Threads or processes to subdivide on (Stolte §5.2,
+        :mod:`implicitvox.octree.subtrees`): threads of this process for a
+        model on the compiled kernel (:mod:`implicitvox.octree.descend`, which
+        releases the GIL), processes for the others. Default: every core this
+        process may use, or one (serial) for a run estimated below
+        :data:`implicitvox.parallel.MIN_PARALLEL_WORK` surface voxels.
         The voxels, interior and normals are bit-identical for any number.
     executor : concurrent.futures.Executor or dask.distributed.Client, optional
         Run the pieces there instead (a Dask client: on its cluster;
@@ -194,6 +193,10 @@ def voxelize(shape: Any, resolution: Union[int, tuple[int, int, int], None] = No
     Returns
     -------
     Voxels
+        Its ``metadata`` records the run: ``seconds_subdivide``,
+        ``seconds_total``, ``boxes_evaluated``, ``tapes_built`` (pruned tapes),
+        ``estimated_voxels``, ``workers`` and ``parallel`` (where they ran:
+        ``"serial"``, ``"threads"``, ``"processes"`` or ``"executor"``).
 
     Raises
     ------
@@ -217,7 +220,7 @@ def _run(source: ImplicitSource, grid: Grid, run: Run, start, interior_before) -
     """Estimate, refuse over the budget, then subdivide under a guard of the same budget."""
     shape, func, options = source.shape, source.func, source.options
     estimate, estimated_bytes = estimate_memory(func, grid, options.normals, options.prune)
-    workers = run.workers_for(estimate.voxels, compiled=runs_compiled(func.tape, grid))
+    workers = run.workers_for(estimate.voxels)
     per_voxel = bytes_per_voxel(options.normals)
     if workers > 1:
         estimated_bytes = parallel_bytes(estimate.voxels, per_voxel, working_bytes(grid),
@@ -257,6 +260,7 @@ def _run(source: ImplicitSource, grid: Grid, run: Run, start, interior_before) -
         "tapes_built": result.tapes_built,
         "estimated_voxels": estimate.voxels,
         "workers": workers if split is not None else 1,
+        "parallel": split.on if split is not None else "serial",
         "implicitvox": __version__,
     }
     return Voxels(grid, tree, interior, metadata, source=source)

@@ -95,10 +95,12 @@ def test_any_schedule_gives_the_serial_voxels(seed):
     assert digest(vox) == digest(serial)
 
 
-def test_any_process_pool_as_executor():
-    """An Executor of the user's (the job goes with each piece, prepared once per worker)."""
+@pytest.mark.parametrize("name", ["lobed-plate", "menger"])
+def test_any_process_pool_as_executor(name):
+    """An Executor of the user's (the job goes with each piece, prepared once per
+    worker; on the compiled kernel, with the head's pool of pruned tapes)."""
     from concurrent.futures import ProcessPoolExecutor
-    shape = examples.example("lobed-plate")
+    shape = examples.example(name)
     serial = iv.voxelize(shape, 40, interior=True, normals=True, workers=1)
     with ProcessPoolExecutor(2) as pool:
         vox = iv.voxelize(shape, 40, interior=True, normals=True, executor=pool, workers=2)
@@ -278,19 +280,41 @@ def test_a_forked_child_has_its_own_pool_and_its_workers_die_with_it(tmp_path):
             pass
 
 
-def test_a_model_on_the_compiled_kernel_defaults_to_one_process(monkeypatch):
-    """For now (Run.workers_for): without workers, an executor or $IMPLICITVOX_WORKERS,
-    a model the compiled kernel takes runs in one process; one on the array path still
-    takes every core; an explicit count or the variable is obeyed."""
+def test_a_model_on_the_compiled_kernel_subdivides_on_threads(monkeypatch):
+    """By default, a model the compiled kernel takes is voxelized on threads of this
+    process (no process pool starts), each piece on the head's pruned tapes, with
+    the voxels, interior, normals and boxes evaluated of one thread. Meshing it
+    stays in one worker by default (Run.workers_for); a count is obeyed."""
+    import threading
+    from implicitvox.octree.subtrees import SubtreeJob
     from implicitvox.parallel import plan
+    farms = sys.modules["implicitvox.parallel.farm"]      # (the package exports the function)
     monkeypatch.setattr(plan, "MIN_PARALLEL_WORK", 1)
     monkeypatch.setattr(plan, "available_cores", lambda: 2)
     monkeypatch.delenv("IMPLICITVOX_WORKERS", raising=False)
-    assert iv.voxelize(examples.example("gear"), 48).metadata["workers"] == 1
-    assert iv.voxelize(examples.example("sinsin34"), 48).metadata["workers"] == 2
-    assert iv.voxelize(examples.example("gear"), 48, workers=2).metadata["workers"] == 2
-    monkeypatch.setenv("IMPLICITVOX_WORKERS", "2")
-    assert iv.voxelize(examples.example("gear"), 48).metadata["workers"] == 2
+
+    def no_processes(*args, **kwargs):
+        raise AssertionError("a process pool was started")
+    monkeypatch.setattr(farms, "_OwnPool", no_processes)
+    seen = []
+    run = SubtreeJob.run
+
+    def watched(self, piece):
+        seen.append((threading.current_thread().name, self.pool.base is not None
+                     and bool((piece[1] > 0).any())))
+        return run(self, piece)
+    monkeypatch.setattr(SubtreeJob, "run", watched)
+    shape = examples.menger(2)
+    threaded = iv.voxelize(shape, 64, interior=True, normals=True)
+    serial = iv.voxelize(shape, 64, interior=True, normals=True, workers=1)
+    assert threaded.metadata["workers"] == 2 and threaded.metadata["parallel"] == "threads"
+    assert seen and all(name.startswith("implicitvox") for name, _ in seen)
+    assert any(pruned for _, pruned in seen), "no piece started on a pruned tape"
+    assert digest(threaded) == digest(serial)
+    assert threaded.metadata["boxes_evaluated"] == serial.metadata["boxes_evaluated"]
+    gear = examples.example("gear")
+    assert iv.mesh(gear, resolution=12).field_data["workers"][0] == 1
+    assert iv.mesh(gear, resolution=12, workers=2).field_data["workers"][0] == 2
 
 
 def test_the_default_uses_every_core_when_it_pays(monkeypatch):

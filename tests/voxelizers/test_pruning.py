@@ -109,3 +109,42 @@ def solids(draw):
 def test_random_csg_trees(solid):
     bounds = ((-1.5,) * 3, (1.5,) * 3)
     _both(solid, 24, bounds=bounds, interior=True, normals=True)
+
+
+@pytest.mark.parametrize("carry", ["as is", "copy", "pickle"])
+def test_subtrees_continue_on_the_heads_pruned_tapes(carry):
+    """A head run's pending octants keep their pruned tapes; continued from them in
+    a copied or pickled pool (as a thread or a process does), the pieces find the
+    serial run's voxels and interior, and the head's pool is left as it was."""
+    import pickle
+
+    from implicitvox.eval.function import Function
+    from implicitvox.octree.grid import Grid
+    from implicitvox.octree.octants import PrunedTapes
+
+    func = Function(menger(2).expr)
+    grid = Grid.from_bounds(((-1.0,) * 3, (1.0,) * 3), 64)
+    serial = subdivision.subdivide(func, grid, interior=True)
+    head = subdivision.subdivide(func, grid, interior=True, until_level=3)
+    seeds = head.pending_tapes
+    assert seeds is not None and len(seeds) == len(head.pending)
+    assert (seeds.tapes > 0).any(), "no pending octant has a pruned tape"
+    pool = seeds.pool
+    before = (len(pool), pool.rows[:pool.used[0]].copy())
+    twin = {"as is": pool, "copy": pool.copy(),
+            "pickle": pickle.loads(pickle.dumps(pool))}[carry]
+    assert len(twin) == len(pool)
+    assert all(twin.tape(i).instructions == pool.tape(i).instructions for i in range(len(pool)))
+    codes, interior = [head.codes], {lvl: [c] for lvl, c in head.interior.items()}
+    for part in np.array_split(np.arange(len(head.pending)), 3):
+        coords = subdivision.unpack(head.pending[part])
+        piece = subdivision.subdivide(func, grid, interior=True, start=(3, coords),
+                                      start_tapes=PrunedTapes(twin, seeds.tapes[part]))
+        codes.append(piece.codes)
+        for lvl, c in piece.interior.items():
+            interior.setdefault(lvl, []).append(c)
+    assert np.array_equal(np.sort(np.concatenate(codes)), np.sort(serial.codes))
+    for lvl, c in serial.interior.items():
+        joined = np.concatenate(interior[lvl])
+        assert np.array_equal(joined[np.lexsort(joined.T[::-1])], c[np.lexsort(c.T[::-1])])
+    assert len(pool) == before[0] and np.array_equal(pool.rows[:pool.used[0]], before[1])
