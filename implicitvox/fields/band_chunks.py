@@ -1,5 +1,9 @@
 """The band's samples computed in chunks, here or on workers (Stolte §5.2's farm).
 
+A mesh's distances run in compiled code that releases the GIL
+(:mod:`implicitvox.linf.mesh_walk`): their chunks go to threads of this
+process; the other kernels' to processes.
+
 A :class:`DistanceKernel` names everything a kernel needs (the shape, the norm,
 the certified search's boxes and limits) and builds it where it runs, once;
 :func:`band_distances` runs it over the samples in chunks of :data:`CHUNK`
@@ -98,7 +102,8 @@ def band_distances(spec: DistanceKernel, grid: Grid, weights: np.ndarray, coords
         for i, (v, e) in farm(job, [coords[s:s + chunk] for s in starts], workers=n,
                               executor=run.executor, progress=run.progress,
                               weights=[min(chunk, len(coords) - s) for s in starts],
-                              what=f"computing distances at {grid.shape}"):
+                              what=f"computing distances at {grid.shape}",
+                              threads=spec.cost == "mesh"):
             values[starts[i]:starts[i] + chunk], errors[starts[i]:starts[i] + chunk] = v, e
         return values, errors, n
     for s in starts:

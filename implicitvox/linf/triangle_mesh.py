@@ -1,15 +1,13 @@
 """Max-norm distance to triangle meshes with bound culling (Varadhan §3.3, §4.1).
 
-For each query point:
-
-1. an upper bound: the exact distance to the triangles whose centroids are
-   nearest in the max-norm (a k-d tree, :class:`scipy.spatial.cKDTree`);
-2. culling (§4.1): a bounding volume hierarchy (triangles in Morton order,
-   leaves of 2, boxes merged pairwise level by level) is walked from the
-   root for all points at once; a (point, node) pair survives only if the
-   node's box - a lower bound - is no farther than the upper bound;
-3. the exact distance to each surviving triangle
-   (:func:`~implicitvox.linf.polyhedron.triangle_distance`), and the minimum.
+A bounding volume hierarchy (triangles in Morton order of their centroids,
+leaves of 2, boxes merged pairwise level by level) is walked per query point
+in compiled code (:mod:`implicitvox.linf.mesh_walk`): depth first, the nearer
+child first, a node dropped when its box - a lower bound - lies farther than
+the least exact distance found so far - an upper bound (Varadhan §4.1); at the
+leaves, the exact distance to each triangle
+(:func:`~implicitvox.linf.polyhedron.triangle_distance`'s separating axes, or
+the Euclidean closest point), and the minimum.
 
 The sign comes from the exact winding number of a closed mesh
 (:class:`~implicitvox.triangles.crossings.RayWinding`); open meshes give unsigned
@@ -35,13 +33,10 @@ from ..triangles.inputs import as_triangles
 from ..octree import morton
 from .box_tests import Primitive
 from .norm import as_points, as_weights, in_blocks
-from .polyhedron import triangle_distance
-from .euclidean import triangle_distance as triangle_euclidean
 from .. import batches
 
 __all__ = ["TriangleMesh"]
 
-_NEAREST = 2          # centroids whose triangles set the upper bound
 _BLOCK = batches.LINF_MESH_POINTS
 _LEAF = 2             # triangles per leaf of the hierarchy
 
@@ -51,13 +46,11 @@ class TriangleMesh(Primitive):
     exactly two faces), else unsigned."""
 
     def __init__(self, vertices: Any, faces: Any):
-        from scipy.spatial import cKDTree
         v, f = as_triangles((vertices, faces))
         if not len(f):
             raise ValueError("the mesh has no triangles")
-        self.tri = v[f]
+        self.tri = np.ascontiguousarray(v[f], dtype=np.float64)
         self.centroids = self.tri.mean(axis=1)
-        self.tree = cKDTree(self.centroids)
         self._build_bvh()
         edges = np.sort(np.concatenate([f[:, [0, 1]], f[:, [1, 2]], f[:, [2, 0]]]), axis=1)
         _, counts = np.unique(edges, axis=0, return_counts=True)
@@ -87,6 +80,11 @@ class TriangleMesh(Primitive):
                 bhi = np.concatenate([bhi, np.full((1, 3), -np.inf)])
             levels.append((np.minimum(blo[0::2], blo[1::2]), np.maximum(bhi[0::2], bhi[1::2])))
         self.levels = levels[::-1]                       # root first
+        # the same, flattened for compiled code: level d in rows first[d]:first[d] + sizes[d]
+        self.sizes = np.array([len(lo) for lo, _ in self.levels], dtype=np.int64)
+        self.first = np.concatenate([[0], np.cumsum(self.sizes)[:-1]]).astype(np.int64)
+        self.box_lo = np.ascontiguousarray(np.concatenate([lo for lo, _ in self.levels]))
+        self.box_hi = np.ascontiguousarray(np.concatenate([hi for _, hi in self.levels]))
 
     def distance(self, points: Any, weights: Any = None) -> np.ndarray:
         """Weighted max-norm distance (negative inside a closed mesh)."""
@@ -111,47 +109,14 @@ class TriangleMesh(Primitive):
         return np.where(inside & (unsigned > 0), -unsigned, unsigned)
 
     def _unsigned(self, p: np.ndarray, w: np.ndarray, euclidean: bool = False) -> np.ndarray:
-        if euclidean:
-            def gap(lo, hi, q, _w):
-                return np.linalg.norm(np.maximum(np.maximum(lo - q, q - hi), 0), axis=1)
-
-            def exact(q, tri, _w):
-                return triangle_euclidean(q, tri)
-        else:
-            def gap(lo, hi, q, ww):
-                return np.max(np.maximum(np.maximum(lo - q, q - hi), 0) / ww, axis=1)
-            exact = triangle_distance
-        k = min(_NEAREST, len(self.tri))
-        _, near = self.tree.query(p / 1.0, k=k, p=2 if euclidean else np.inf)
-        near = near.reshape(len(p), k)
-        rows = np.repeat(np.arange(len(p)), k)
-        d = exact(p[rows], self.tri[near.ravel()], w[rows]).reshape(len(p), k)
-        upper = d.min(axis=1)
-        # Varadhan §4.1: walk the hierarchy from the root, keeping (point, node) pairs
-        # whose box is no farther than the point's upper bound (the lower bound culls)
-        pt = np.arange(len(p))
-        node = np.zeros(len(p), dtype=np.int64)
-        for depth in range(1, len(self.levels)):
-            blo, bhi = self.levels[depth]
-            pt = np.repeat(pt, 2)
-            node = (2 * np.repeat(node, 2)) + np.tile([0, 1], len(node))
-            ok = node < len(blo)
-            pt, node = pt[ok], node[ok]
-            keep = gap(blo[node], bhi[node], p[pt], w[pt]) <= upper[pt]
-            pt, node = pt[keep], node[keep]
-        # the leaves' triangles, exactly
-        pt = np.repeat(pt, _LEAF)
-        idx = (np.repeat(node, _LEAF) * _LEAF) + np.tile(np.arange(_LEAF), len(node))
-        ok = idx < len(self.tri)
-        pt, idx = pt[ok], idx[ok]
-        cand = self.order[idx]
-        keep = gap(self.tri[cand].min(axis=1), self.tri[cand].max(axis=1), p[pt], w[pt]) \
-            <= upper[pt]
-        pt, cand = pt[keep], cand[keep]
-        dist = exact(p[pt], self.tri[cand], w[pt])
-        best = upper.copy()
-        np.minimum.at(best, pt, dist)
-        return best
+        """The culled walk of the hierarchy per point, in compiled code
+        (:func:`implicitvox.linf.mesh_walk.nearest_distances`)."""
+        from .mesh_walk import nearest_distances      # (loads Numba: not at import)
+        out = np.empty(len(p))
+        nearest_distances(np.ascontiguousarray(p, dtype=np.float64),
+                          np.ascontiguousarray(w, dtype=np.float64), self.box_lo, self.box_hi,
+                          self.first, self.sizes, self.tri, self.order, _LEAF, euclidean, out)
+        return out
 
     @property
     def bounds(self):

@@ -11,7 +11,7 @@ For each case, in one process, alternately (best of ``--repeat`` each):
   subdivision releases the GIL, and the pieces start on the head's pruned
   tapes), a pool of processes of this machine for the others; the row says
   which (``2 threads``, ``2 processes``);
-* ``threads``: a ``ThreadPoolExecutor(2)`` as the executor (``--threads``): on
+* ``ThreadPoolExecutor(2)`` as the executor (``--threads``): on
   the array path the kernels are numpy calls that hold the GIL between them,
   so this measures what processes buy over threads there;
 * ``LocalCluster``: a Dask ``LocalCluster(n_workers=2, processes=True)``
@@ -160,7 +160,7 @@ def main() -> None:
         return huge(load, args.quick)
     local = {"workers=2": {"workers": 2}}
     if args.threads:
-        local["2 threads"] = "threads"
+        local["ThreadPoolExecutor(2)"] = "threads"
     rows = timings(args, local)                      # no cluster on the machine
     if not args.no_dask:
         with _cluster() as address:                  # then beside the cluster

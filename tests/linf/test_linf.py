@@ -8,6 +8,7 @@ from scipy.optimize import linprog
 import implicitvox as ivx
 from implicitvox import linf
 from implicitvox.expr.shape import AMBIGUOUS, EMPTY, FULL
+from implicitvox.linf.euclidean import triangle_distance as euclidean_triangle_distance
 from tests.support.linf_oracle import (corner_depth, dual_distance, ellipsoid_support, frustum_support,
                                 quadric_box_range, quadric_distance, torus_surface_distance)
 
@@ -128,8 +129,38 @@ def test_mesh_matches_brute_force():
         brute[s:s + k] = linf.triangle_distance(
             np.repeat(p[s:s + 16], len(tri), 0), np.tile(tri, (k, 1, 1)),
             np.repeat(w[s:s + 16], len(tri), 0)).reshape(k, len(tri)).min(axis=1)
-    np.testing.assert_allclose(np.abs(d), brute, rtol=1e-12, atol=1e-12)
+    # the compiled walk computes each triangle's distance as the array kernel does
+    np.testing.assert_array_equal(np.abs(d), brute)
     assert mesh.closed and (d < 0).any() and (d > 0).any()
+    e = mesh.euclidean_distance(p[:2000])
+    brute_e = np.array([euclidean_triangle_distance(np.repeat(q[None], len(tri), 0), tri).min()
+                        for q in p[:2000]])
+    np.testing.assert_allclose(np.abs(e), brute_e, rtol=1e-12, atol=1e-12)
+
+
+def _triangles_and_points(rng, n):
+    """Random triangles, with degenerate ones (a repeated vertex, collinear vertices,
+    an axis-parallel edge), and points, some in a triangle's plane or on its vertex."""
+    tri = rng.normal(size=(n, 3, 3))
+    tri[0::7, 1] = tri[0::7, 0]                                  # a zero edge
+    tri[1::7, 2] = 2 * tri[1::7, 1] - tri[1::7, 0]               # collinear
+    tri[2::7, 1, 1:] = tri[2::7, 0, 1:]                          # an edge along x
+    p = rng.normal(size=(n, 3)) * 2
+    p[3::7] = tri[3::7].mean(axis=1)                              # in the plane
+    p[4::7] = tri[4::7, 2]                                        # on a vertex
+    return tri, p, rng.uniform(0.25, 4.0, (n, 3))
+
+
+def test_compiled_triangle_distances_are_the_array_kernels():
+    from implicitvox.linf.mesh_walk import triangle_euclidean, triangle_linf
+    tri, p, w = _triangles_and_points(np.random.default_rng(8), 3000)
+    ours = np.array([triangle_linf(*p[k], *w[k], tri[k]) for k in range(len(p))])
+    np.testing.assert_array_equal(ours, linf.triangle_distance(p, tri, w))
+    ours = np.array([triangle_euclidean(*p[k], tri[k]) for k in range(len(p))])
+    # (the array kernel sums its dot products in numpy's order: equal up to rounding at
+    # the coordinates' scale, which is 1 here)
+    np.testing.assert_allclose(ours, euclidean_triangle_distance(p, tri), rtol=1e-13,
+                               atol=1e-14)
 
 
 def _brute_classify_sphere(c, r, lo, hi):
