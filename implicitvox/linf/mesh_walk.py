@@ -81,6 +81,14 @@ def _along2(ua, ub, a, b, p, w, t):
 
 @njit(**COMPILE)
 def _triangle_linf(p, w, t):
+    return _triangle_linf_below(p, w, t, np.inf)
+
+
+@njit(**COMPILE)
+def _triangle_linf_below(p, w, t, bound):
+    """The weighted max-norm distance from ``p`` to triangle ``t`` where it is below
+    ``bound``; else some value at least ``bound`` (the axes stop as soon as one
+    reaches it: the distance is their maximum)."""
     best = 0.0
     for a in range(3):                      # the box normals: the triangle's bounding box
         lo = min(min(t[0, a], t[1, a]), t[2, a])
@@ -99,12 +107,16 @@ def _triangle_linf(p, w, t):
     lo = min(min(d0, d1), d2)
     hi = max(max(d0, d1), d2)
     best = _fmax(best, max(lo - q, q - hi) / h if h > 0 else 0.0)
+    if best >= bound:
+        return best
     for k in range(3):                      # the box axes crossed with each edge
         k1 = (k + 1) % 3
         g0, g1, g2 = t[k1, 0] - t[k, 0], t[k1, 1] - t[k, 1], t[k1, 2] - t[k, 2]
         best = _fmax(best, _along2(-g2, g1, 1, 2, p, w, t))
         best = _fmax(best, _along2(g2, -g0, 0, 2, p, w, t))
         best = _fmax(best, _along2(-g1, g0, 0, 1, p, w, t))
+        if best >= bound:
+            return best
     return best
 
 
@@ -284,15 +296,20 @@ def nearest_distances(points, weights, box_lo, box_hi, first, sizes, tri, order,
     stack_node = np.empty(2 * depth + 2, dtype=np.int64)
     stack_gap = np.empty(2 * depth + 2)
     found = np.empty(MAX_CANDIDATES, dtype=np.int64)
-    tlo = np.empty((tri.shape[0], 3))           # each triangle's box (computed once, lazily)
-    thi = np.empty((tri.shape[0], 3))
-    boxed = np.zeros(tri.shape[0], dtype=np.bool_)
+    clo, chi = np.empty((3, MAX_CANDIDATES)), np.empty((3, MAX_CANDIDATES))
+    gaps = np.empty(MAX_CANDIDATES)
     glo, ghi, gw = np.empty(3), np.empty(3), np.empty(3)
     slack = 1.0 + EUCLIDEAN_SLACK if euclidean else 1.0
     exact = 0
+    seed = -1
     for g in range(0, n, GROUP):
         e = min(g + GROUP, n)
-        best, seed, done = _walk(points[g], weights[g], np.inf, -1, box_lo, box_hi, first,
+        best = np.inf
+        if seed >= 0:          # the last group's nearest triangle: an upper bound to start from
+            best = _triangle_euclidean(points[g], tri[seed]) if euclidean else \
+                _triangle_linf(points[g], weights[g], tri[seed])
+            exact += 1
+        best, seed, done = _walk(points[g], weights[g], best, seed, box_lo, box_hi, first,
                                  sizes, tri, order, leaf, euclidean, slack, stack_level,
                                  stack_node, stack_gap)
         exact += done
@@ -323,23 +340,49 @@ def nearest_distances(points, weights, box_lo, box_hi, first, sizes, tri, order,
                 out[i] = best
                 exact += done
             continue
-        for c in range(count):
+        for c in range(count):         # the candidates' boxes, side by side
             k = found[c]
-            if not boxed[k]:
-                for a in range(3):
-                    tlo[k, a] = min(min(tri[k, 0, a], tri[k, 1, a]), tri[k, 2, a])
-                    thi[k, a] = max(max(tri[k, 0, a], tri[k, 1, a]), tri[k, 2, a])
-                boxed[k] = True
+            for a in range(3):
+                clo[a, c] = min(min(tri[k, 0, a], tri[k, 1, a]), tri[k, 2, a])
+                chi[a, c] = max(max(tri[k, 0, a], tri[k, 1, a]), tri[k, 2, a])
         for i in range(g + 1, e):
             p, w = points[i], weights[i]
-            best = out[i]
+            # every candidate's box distance first (a loop the compiler vectorizes), then
+            # the exact distance of the nearest box, then of each box still near enough
+            nearest, least = 0, np.inf
             for c in range(count):
-                k = found[c]
-                if _box_gap(tlo, thi, k, p, w, euclidean) > best * slack:
+                if euclidean:
+                    total = 0.0
+                    for a in range(3):
+                        v = max(max(clo[a, c] - p[a], p[a] - chi[a, c]), 0.0)
+                        total += v * v
+                    gaps[c] = total               # squared
+                else:
+                    v = 0.0
+                    for a in range(3):
+                        v = max(v, max(max(clo[a, c] - p[a], p[a] - chi[a, c]), 0.0) / w[a])
+                    gaps[c] = v
+            for c in range(count):
+                if gaps[c] < least:
+                    nearest, least = c, gaps[c]
+            best = out[i]
+            if euclidean:
+                limit = best * slack
+                limit = limit * limit
+            else:
+                limit = best
+            for r in range(count + 1):
+                c = nearest if r == 0 else r - 1
+                if (r > 0 and c == nearest) or gaps[c] > limit:
                     continue
-                d = _triangle_euclidean(p, tri[k]) if euclidean else _triangle_linf(p, w, tri[k])
+                k = found[c]
+                if euclidean:
+                    d = _triangle_euclidean(p, tri[k])
+                else:
+                    d = _triangle_linf_below(p, w, tri[k], best)
                 exact += 1
                 if d < best:
                     best = d
+                    limit = best * slack * best * slack if euclidean else best
             out[i] = best
     return exact
