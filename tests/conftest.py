@@ -26,7 +26,9 @@ def pytest_configure(config):
     cache instead of each compiling the same functions (about 25 s apiece cold)."""
     if hasattr(config, "workerinput"):       # a worker: the controller did it
         return
+    from implicitvox.linf import mesh_walk
     from implicitvox.octree.descend import warm_up
     warm_up()
+    mesh_walk.warm_up()
 if os.environ.get("CI"):
     settings.load_profile("ci")

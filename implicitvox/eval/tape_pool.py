@@ -118,10 +118,11 @@ class TapePool:
         self.params[fixed:] = compiled.params
         self.constant_lo = np.zeros(fixed)
         self.constant_hi = np.zeros(fixed)
+        self.constant_value = np.zeros(fixed)       # the constants' point values
         self.inputs = np.full(3, -1, dtype=np.int32)
         for k, value in enumerate(values[:fixed]):
             if value.kind == "const":
-                self.constant_lo[k], self.constant_hi[k] = value.const[1], value.const[2]
+                self.constant_value[k], self.constant_lo[k], self.constant_hi[k] = value.const
             else:
                 self.inputs["xyz".index(value.param)] = k
         self.is_constant = np.array([v.kind == "const" for v in values[:fixed]], dtype=np.bool_)

@@ -42,7 +42,8 @@ from numba import njit
 
 from ..interval.rules import COMPILE
 
-__all__ = ["triangle_linf", "triangle_euclidean", "nearest_distances", "EUCLIDEAN_SLACK",
+__all__ = ["triangle_linf", "triangle_euclidean", "nearest_distances", "warm_up",
+           "EUCLIDEAN_SLACK",
            "GROUP", "MAX_CANDIDATES"]
 
 #: the Euclidean walk keeps a box up to this relative amount farther than the best
@@ -386,3 +387,14 @@ def nearest_distances(points, weights, box_lo, box_hi, first, sizes, tri, order,
                     limit = best * slack * best * slack if euclidean else best
             out[i] = best
     return exact
+
+
+def warm_up() -> None:
+    """Compile the walk for both norms, or load it from Numba's on-disk cache (the
+    test suite calls it before its workers start)."""
+    tri = np.array([[[0.0, 0, 0], [1, 0, 0], [0, 1, 0]]] * 2)
+    points = np.zeros((3, 3))
+    for euclidean in (False, True):
+        nearest_distances(points, np.ones((3, 3)), tri[:, 0].copy(), tri[:, 1].copy(),
+                          np.zeros(1, dtype=np.int64), np.ones(1, dtype=np.int64), tri,
+                          np.arange(2, dtype=np.int64), 2, euclidean, np.empty(3))

@@ -156,15 +156,18 @@ ROWS_PER_CALL = 1 << 17
 
 
 def warm_up() -> None:
-    """Compile the kernel's functions, or load them from Numba's on-disk cache: one
-    small run through every compiled path (about 25 s the first time on a 2-core
+    """Compile the subdivision's functions (and the pool's gradients), or load them
+    from Numba's on-disk cache: one small run through every compiled path (about 25 s the first time on a 2-core
     machine, a second once cached). The test suite calls it once before its
     workers start, so they load what it wrote instead of each compiling."""
     from ..expr import functions as fn
     from ..expr.nodes import x, y, z
+    from ..eval.pool_gradients import pool_gradients
     parts = fn.min(fn.sqrt(x * x + y * y + z * z) - 0.5, fn.abs(x) - 0.3)
-    descend(Function(fn.max(parts, -parts - 0.1)), Grid.from_bounds(((-1.0,) * 3, (1.0,) * 3), 8),
-            interior=True)
+    found = descend(Function(fn.max(parts, -parts - 0.1)),
+                    Grid.from_bounds(((-1.0,) * 3, (1.0,) * 3), 8), interior=True)
+    runs = found.tapes
+    pool_gradients(runs.pool, runs.ids[:1], np.ones(1, dtype=np.int64), *np.zeros((3, 1)))
 
 
 def descend(func: Function, grid: Grid, *, start: Optional[tuple[int, np.ndarray]] = None,
@@ -317,7 +320,7 @@ def descend(func: Function, grid: Grid, *, start: Optional[tuple[int, np.ndarray
         interior={lvl: unpack(np.sort(np.concatenate(parts)))   # Morton order: any schedule
                   for lvl, parts in sorted(interior_parts.items())},
         evaluated=evaluated,
-        tapes=TapeRuns(counts, lambda i: pool.tape(int(ids[i]))),
+        tapes=TapeRuns(counts, lambda i: pool.tape(int(ids[i])), pool, ids),
         tapes_built=len(pool) - 1,
         pending=held.codes[order] if held is not None else np.zeros(0, dtype=np.uint64),
         pending_tapes=PrunedTapes(pool, held.tapes[order]) if held is not None else None)

@@ -87,12 +87,19 @@ class TapeRuns(Sequence):
         Voxels per run.
     build : callable
         ``build(i)``: the tape of run ``i``.
+    pool : TapePool, optional
+        The pool the tapes come from, with ``ids``, each run's pool tape (for
+        compiled code that runs them without building them:
+        :mod:`implicitvox.eval.pool_gradients`).
     """
 
-    def __init__(self, counts: Any, build: Callable[[int], Tape]):
+    def __init__(self, counts: Any, build: Callable[[int], Tape], pool: Any = None,
+                 ids: Any = None):
         self.counts = np.asarray(counts, dtype=np.int64)
         self._build = build
         self._built: dict[int, Tape] = {}
+        self.pool = pool
+        self.ids = None if ids is None else np.asarray(ids, dtype=np.int64)
 
     def __len__(self) -> int:
         return len(self.counts)
@@ -125,7 +132,8 @@ class TapeRuns(Sequence):
         """The runs with ``counts`` voxels instead, runs of none dropped."""
         counts = np.asarray(counts, dtype=np.int64)
         kept = np.flatnonzero(counts)
-        return TapeRuns(counts[kept], lambda i: self.tape(int(kept[i])))
+        return TapeRuns(counts[kept], lambda i: self.tape(int(kept[i])), self.pool,
+                        None if self.ids is None else self.ids[kept])
 
 
 @dataclass(frozen=True)

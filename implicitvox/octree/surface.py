@@ -19,7 +19,7 @@ from . import morton
 from .grid import Grid
 from .guard import MemoryGuard
 from .morton import MAX_BITS
-from .octants import PrunedTapes, recount, run_counts
+from .octants import PrunedTapes, TapeRuns, recount, run_counts
 from .subdivide import RECHECK, Subdivision, subdivide
 
 __all__ = ["SurfaceOptions", "subdivide_voxels", "interior_from_subvoxels", "voxel_normals",
@@ -70,6 +70,10 @@ def voxel_normals(func: Function, grid: Grid, coords: np.ndarray,
     voxels (the pruned tapes :attr:`Subdivision.tapes`; the same gradients,
     bit for bit, in fewer operations); default the function's own tape."""
     out = np.zeros((len(coords), 3), dtype=np.float32)
+    if isinstance(tapes, TapeRuns) and tapes.pool is not None:
+        from ..eval.pool_gradients import pool_gradients, takes_pool   # (loads Numba)
+        if takes_pool(tapes.pool):
+            return _pool_normals(tapes, grid, coords, out, pool_gradients)
     runs = tapes if tapes is not None else [(len(coords), func.tape)]
     start = 0
     for count, tape in runs:
@@ -79,6 +83,23 @@ def voxel_normals(func: Function, grid: Grid, coords: np.ndarray,
             _, g = evaluate_gradients(tape, c[:, 0], c[:, 1], c[:, 2])
             out[s:e] = unit_vectors(g.T)
         start += count
+    return out
+
+
+def _pool_normals(runs: TapeRuns, grid: Grid, coords: np.ndarray, out: np.ndarray,
+                  pool_gradients) -> np.ndarray:
+    """:func:`voxel_normals` on the pool tapes of ``runs`` in compiled code
+    (:mod:`implicitvox.eval.pool_gradients`), in chunks of voxels."""
+    ends = np.cumsum(runs.counts)
+    starts = ends - runs.counts
+    for s in range(0, len(coords), _NORMALS_CHUNK):
+        e = min(s + _NORMALS_CHUNK, len(coords))
+        first, last = np.searchsorted(ends, s, side="right"), np.searchsorted(starts, e)
+        counts = np.minimum(ends[first:last], e) - np.maximum(starts[first:last], s)
+        c = grid.centers(coords[s:e])
+        _, g = pool_gradients(runs.pool, runs.ids[first:last], counts, c[:, 0], c[:, 1],
+                              c[:, 2])
+        out[s:e] = unit_vectors(g.T)
     return out
 
 

@@ -61,3 +61,51 @@ def test_min_max_abs_floor_take_the_active_branch():
     _, g = f.gradient(np.array([1.0]), np.array([-1.0]), np.array([0.5]))
     # min picks 3y (-3 < 2), max picks x (1 > -0.5), |y| has slope -1 at y = -1.
     np.testing.assert_array_equal(g[0], [1.0, 3.0 - 1.0, 0.0])
+
+
+def _csg_models():
+    from implicitvox.expr.shape import ExprShape
+    import csg
+    from implicitvox.expr.examples import drilled_plate, menger, sphere_union
+    blend = (csg.Box((1.2, 1.0, 0.8), center=True) - csg.Cylinder(h=2.0, r=0.3, center=True)) \
+        | csg.Sphere(0.4, center=(0.5, 0.4, 0.3))
+    return {"menger": menger(2), "spheres": sphere_union(20), "plate": drilled_plate(4, 4),
+            "csg": blend, "floor": ExprShape(
+                ivx.floor(3 * x) / 3 + ivx.abs(y) - ivx.min(z, 0.5 * x) - 0.4,
+                ((-1.0,) * 3, (1.0,) * 3))}
+
+
+def test_pool_gradients_are_the_array_evaluators_bit_for_bit(monkeypatch):
+    """Compiled values and gradients on every pruned tape of a subdivision, at voxel
+    centres and random points (on a tape's own voxels and elsewhere, where its
+    branches may be wrong but its arithmetic is the same), equal the array
+    evaluator's on the same tape, bit for bit; a pool with libm operations is
+    declined."""
+    from implicitvox.eval.gradient import evaluate_gradients
+    from implicitvox.eval.pool_gradients import pool_gradients
+    from implicitvox.expr.shape import as_shape
+    from implicitvox.octree import descend
+    from implicitvox.octree.grid import Grid
+    from implicitvox.eval.function import Function
+    monkeypatch.setattr(descend, "DERIVE_COST", 0)
+    rng = np.random.default_rng(5)
+    for name, model in _csg_models().items():
+        shape = as_shape(model)
+        grid = Grid.from_bounds(shape.bounds, 24)
+        result = descend.descend(Function(shape.expr), grid)
+        runs = result.tapes
+        assert runs.pool is not None and len(runs) > 1, name
+        counts = rng.integers(1, 40, len(runs))
+        pts = rng.uniform(-1.2, 1.2, (3, int(counts.sum())))
+        pts[:, :8] = 0.0                                   # ties of min, max and abs
+        values, grads = pool_gradients(runs.pool, runs.ids, counts, *pts)
+        start = 0
+        for count, tape in zip(counts, (runs.tape(i) for i in range(len(runs)))):
+            v, g = evaluate_gradients(tape, *pts[:, start:start + count])
+            np.testing.assert_array_equal(values[start:start + count], v, err_msg=name)
+            np.testing.assert_array_equal(grads[:, start:start + count], g, err_msg=name)
+            start += count
+    from implicitvox.eval.tape_pool import TapePool
+    from implicitvox.eval.tape import build_tape
+    wavy = TapePool(build_tape(ivx.min(ivx.sin(x) - y, z)))
+    assert pool_gradients(wavy, np.array([0]), np.array([1]), *np.zeros((3, 1))) is None
