@@ -27,6 +27,7 @@ from .. import validate
 from ..expr.nodes import Expr
 from ..expr.shape import as_shape
 from ..linf.triangle_mesh import TriangleMesh
+from ..octree.grid import padded_bounds
 from ..octree.run import Run
 from ..triangles.inputs import as_triangles
 from ..voxelizers.implicit import voxelize
@@ -81,7 +82,11 @@ def distance_field(shape: Any, resolution: Union[int, tuple[int, int, int], None
     resolution : int or (int, int, int), default: 256
         Voxels along the longest side (cubic voxels), or per axis.
     bounds, voxel_size
-        As for :func:`implicitvox.voxelize` (the same grid, the same rule).
+        As for :func:`implicitvox.voxelize`, except that the default bounds reach
+        ``band`` voxels (1 with ``band=None``) past the shape's own on every side
+        (:func:`implicitvox.octree.grid.padded_bounds` with a margin), of the
+        ``resolution`` voxels along the longest side: the samples then enclose
+        the surface, and its isosurface is closed.
     norm : {"euclidean", "linf"}
         The Euclidean distance, or the max-norm of Varadhan et al. (weighted by
         the voxel size over its longest edge when voxels are not cubes, so that
@@ -129,6 +134,12 @@ def distance_field(shape: Any, resolution: Union[int, tuple[int, int, int], None
     run = Run.of(max_memory=max_memory, progress=progress, workers=workers, executor=executor)
     band = None if band is None else validate.int_in(band, "band", 1, MAX_BAND)
     mesh = _as_mesh(shape)
+    target = mesh if mesh is not None else as_shape(shape)
+    own = getattr(target, "bounds", None)
+    if bounds is None and own is not None:
+        # the samples reach past the surface by the band on every side (else the faces
+        # on the shape's extremes have no sample beyond them, and the isosurface is open)
+        bounds = padded_bounds(own, resolution, voxel_size, margin=band or 1)
     t0 = time.perf_counter()
     first = run.part(0.0, 0.2)
     if mesh is not None:
@@ -139,9 +150,7 @@ def distance_field(shape: Any, resolution: Union[int, tuple[int, int, int], None
                             interior=mesh.closed, max_memory=first.budget,
                             progress=first.progress, workers=first.workers,
                             executor=first.executor)
-        target = mesh
     else:
-        target = as_shape(shape)
         vox = voxelize(target, resolution, bounds=bounds, voxel_size=voxel_size, interior=True,
                        max_memory=first.budget, progress=first.progress,
                        workers=first.workers, executor=first.executor)

@@ -54,9 +54,10 @@ def _whole_voxels(extent: float, pitch: float, axis: str) -> int:
     return n
 
 
-def padded_bounds(bounds: Any, resolution: Any = None, voxel_size: Any = None
-                  ) -> tuple[tuple[float, ...], tuple[float, ...]]:
-    """The default grid box of a shape with ``bounds``: grown by half a voxel on every side.
+def padded_bounds(bounds: Any, resolution: Any = None, voxel_size: Any = None,
+                  margin: int = 0) -> tuple[tuple[float, ...], tuple[float, ...]]:
+    """The default grid box of a shape with ``bounds``: grown by half a voxel on every side
+    (and ``margin`` whole voxels more).
 
     This is the one rule for default bounds, used by every voxelizer, the
     ``csg`` solids and the command line. With ``resolution`` ``n`` the voxel
@@ -64,6 +65,9 @@ def padded_bounds(bounds: Any, resolution: Any = None, voxel_size: Any = None
     has ``n`` voxels along the longest side and the centres of its first and
     last voxels lie on the shape's extremes; with ``voxel_size`` the pitch is
     given. A flat shape (zero extent on an axis) gets one voxel of depth there.
+    ``margin`` (a distance field's band): the grid still has ``n`` voxels, of
+    which ``margin`` on each side lie beyond the extremes (the voxel is
+    ``longest side / (n - 1 - 2 margin)``; fewer on a grid too small for them).
     """
     lo = np.asarray(bounds[0], dtype=np.float64)
     hi = np.asarray(bounds[1], dtype=np.float64)
@@ -77,17 +81,20 @@ def padded_bounds(bounds: Any, resolution: Any = None, voxel_size: Any = None
     else:
         res = validate.resolution(resolution, MAX_RESOLUTION)
         counts = np.broadcast_to(np.asarray(res, dtype=np.float64), (3,))
+        margin = max(0, min(int(margin), (int(counts.min()) - 2) // 2))
+        inner = counts - 2 * margin           # voxels from extreme to extreme, centre to centre
         if isinstance(res, tuple):
-            pitch = np.where(counts > 1, extent / np.maximum(counts - 1, 1), extent)
+            pitch = np.where(inner > 1, extent / np.maximum(inner - 1, 1), extent)
         else:
             longest = float(extent.max())
-            pitch = np.full(3, longest / (res - 1) if res > 1 else longest)
+            pitch = np.full(3, longest / (inner[0] - 1) if inner[0] > 1 else longest)
         if not np.all(pitch > 0):
             pitch = np.where(pitch > 0, pitch, float(extent.max()))
     if not np.all(pitch > 0):
         raise ValueError(f"the shape's bounds have no extent (a point at {lo.tolist()}): pass "
                          "bounds or voxel_size")
-    return tuple((lo - pitch / 2).tolist()), tuple((hi + pitch / 2).tolist())
+    reach = pitch * (margin + 0.5)
+    return tuple((lo - reach).tolist()), tuple((hi + reach).tolist())
 
 
 @dataclass(frozen=True)

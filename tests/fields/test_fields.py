@@ -3,6 +3,7 @@ from __future__ import annotations
 
 import math
 import warnings
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -372,3 +373,24 @@ def test_ellipsoid_euclidean_distance_agrees_with_the_certified_bounds():
     sampled, _ = cKDTree(surface).query(p)
     d = -ell.euclidean_distance(p)
     assert np.all(d <= sampled + 1e-9) and np.all(d >= sampled - 1e-3)
+
+
+def test_the_default_grid_reaches_past_the_surface_by_the_band_and_the_isosurface_closes():
+    """OpenSCAD's bracket has faces on its bounding box (x = 0, x = 40, y = 0): the
+    default grid puts `band` voxels of samples beyond them on every side, so the
+    0-isosurface is closed (no boundary edge)."""
+    from csg import read_openscad
+    bracket = read_openscad(str(Path(__file__).resolve().parents[1] / "openscad" / "bracket.csg"))
+    band = 2
+    field = iv.distance_field(bracket, 40, norm="linf", band=band, check_suitability=False)
+    lo, hi = (np.asarray(b) for b in bracket.bounds)
+    h = np.asarray(field.grid.voxel_size)
+    origin = np.asarray(field.grid.origin)
+    top = origin + h * np.asarray(field.grid.shape)
+    assert max(field.grid.shape) == 40
+    assert np.all(lo - origin >= band * h) and np.all(top - hi >= band * h)
+    surface = field.isosurface()
+    assert surface.n_cells > 0
+    edges = surface.extract_feature_edges(boundary_edges=True, non_manifold_edges=False,
+                                          feature_edges=False, manifold_edges=False)
+    assert edges.n_cells == 0, f"{edges.n_cells} boundary edges"
