@@ -26,11 +26,11 @@ from __future__ import annotations
 
 import math
 import numbers
-from typing import Any, Iterator, Mapping
+from typing import Any, Iterator, Mapping, Optional
 
 import numpy as np
 
-__all__ = ["Expr", "wrap", "constant", "x", "y", "z", "VARIABLES"]
+__all__ = ["Expr", "wrap", "constant", "x", "y", "z", "VARIABLES", "source_preview"]
 
 VARIABLES = ("x", "y", "z")
 
@@ -387,15 +387,31 @@ def _remapped(parts: list[tuple[str, int]]) -> str:
     return ".remap(" + ", ".join(f"{v}={p}" for v, p in zip(VARIABLES, names) if p != v) + ")"
 
 
-def _to_source(expr: Expr) -> str:
-    """Python source for ``expr`` (iterative; a summary for huge DAGs)."""
+def _to_source(expr: Expr, limit: Optional[int] = None) -> str:
+    """Python source for ``expr`` (iterative; a summary for huge DAGs), or with
+    ``limit`` its first ``limit`` characters (every node's text cut there: a
+    node's text starts with its first argument's, or with text of its own, so
+    the cut texts give the whole text's first ``limit`` characters)."""
     out: dict[int, tuple[str, int]] = {}
     has_var: dict[int, bool] = {}
     for node in expr.walk():
         parts = [out[id(a)] for a in node.args]
-        if sum(len(p) for p, _ in parts) > _REPR_LIMIT:
+        if limit is None and sum(len(p) for p, _ in parts) > _REPR_LIMIT:
             count = sum(1 for _ in expr.walk())
             return f"<Expr {expr.op}: {count} distinct nodes, too large to print>"
         has_var[id(node)] = node.op == "var" or any(has_var[id(a)] for a in node.args)
-        out[id(node)] = _node_source(node, parts, has_var)
+        text, precedence = _node_source(node, parts, has_var)
+        out[id(node)] = (text if limit is None else text[:limit], precedence)
     return out[id(expr)][0]
+
+
+def source_preview(expr: Expr, limit: int = 2000) -> str:
+    """The first ``limit`` characters of ``repr(expr)``, in time proportional to the
+    expression's nodes (a run's metadata names its model so).
+
+    Examples
+    --------
+    >>> source_preview((x - 1.0) * (x - 1.0) + y, 12)
+    '(x - 1.0) * '
+    """
+    return _to_source(expr, int(limit))

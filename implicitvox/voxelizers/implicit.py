@@ -21,6 +21,7 @@ from .. import batches
 from ..version import __version__
 from ..eval.function import Function
 from ..expr.shape import as_shape, exact_classifier, surface_normals, voxel_classifier
+from ..expr.nodes import source_preview
 from ..meshing.mesher import REFINE, mesh, mesh_grid
 from ..octree.morton import MAX_BITS
 from ..octree.grid import Grid, grid_of
@@ -253,7 +254,7 @@ def _run(source: ImplicitSource, grid: Grid, run: Run, start, interior_before) -
     for level, coords in result.interior.items():
         interior[level] = np.concatenate([interior[level], coords]) if level in interior else coords
     metadata = {
-        "model": repr(func.expr)[:2000],
+        "model": source_preview(func.expr, 2000),
         "seconds_subdivide": t1 - t0,
         "seconds_total": time.perf_counter() - t0,
         "boxes_evaluated": result.evaluated,

@@ -4,6 +4,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 from hypothesis import given, settings
+from hypothesis import strategies as st
 
 import implicitvox as ivx
 from implicitvox import x, y, z
@@ -91,6 +92,22 @@ def test_clip_and_remap():
 @given(expr=expression(5))
 def test_repr_reads_back_as_python(expr):
     assert eval(repr(expr), dict(NAMESPACE)).equals(expr)
+
+
+@settings(max_examples=100, deadline=None)
+@given(expr=expression(5), limit=st.sampled_from([0, 1, 3, 8, 20, 60, 2000]))
+def test_a_source_preview_is_the_start_of_the_repr(expr, limit):
+    from implicitvox.expr.nodes import source_preview
+    assert source_preview(expr, limit) == repr(expr)[:limit]
+
+
+def test_a_huge_model_is_previewed_not_summarized():
+    from implicitvox.expr.examples import sphere_union
+    from implicitvox.expr.nodes import source_preview
+    model = sphere_union(2000).expr
+    assert repr(model).startswith("<Expr")                # the repr's summary
+    preview = source_preview(model, 300)
+    assert len(preview) == 300 and preview.startswith("min(")
 
 
 @pytest.mark.parametrize("text", [
