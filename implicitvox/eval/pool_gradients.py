@@ -39,11 +39,15 @@ import numpy as np
 from numba import njit
 
 from ..interval.rules import COMPILE
+from .compiled import compiled_tape
 from .compiled import (ABS, ADD, ADDC, DISTANCE, DIV, DIVC, FLOOR, HYPOT, MAX, MIN, MUL, MULC,
                        NEG, RADIUS, RSUBC, SQRT, SQUARE, SUB)
-from .tape_pool import ARG_A, ARG_B, ARG_C, OP, OUT, OUTPUT, ROWS, START, VALUE, TapePool
+from .tape import Tape
+from .tape_pool import (ARG_A, ARG_B, ARG_C, OP, OUT, OUTPUT, ROW, ROWS, START, VALUE,
+                        TapePool)
 
-__all__ = ["pool_gradients", "takes_pool", "POINT_OPS"]
+__all__ = ["pool_gradients", "takes_pool", "tape_arrays", "tape_gradients", "crossing_points",
+           "POINT_OPS"]
 
 #: the operations :func:`pool_gradients` runs (numbers of :data:`implicitvox.eval.compiled.OPS`)
 POINT_OPS = frozenset((ADD, SUB, MUL, DIV, NEG, SQUARE, SQRT, ABS, MIN, MAX, ADDC, RSUBC, MULC,
@@ -82,6 +86,66 @@ def pool_gradients(pool: TapePool, tapes: np.ndarray, counts: np.ndarray, xs: np
     return values, grads
 
 
+def tape_arrays(tape: Tape) -> Optional[tuple]:
+    """A :class:`~implicitvox.eval.tape.Tape` as one pool tape's arrays
+    (``rows, length, output, params, is_constant, constant_value, inputs``), or
+    None when it holds an operation this module does not run (or a sweep)."""
+    encoded = compiled_tape(tape)
+    if encoded is None or tape.undefined or \
+            not all(int(op) in POINT_OPS for op in np.unique(encoded.code[:, 0])):
+        return None
+    n = len(encoded.code)
+    rows = np.zeros((max(n, 1), ROW), dtype=np.int32)
+    rows[:n, OP], rows[:n, OUT] = encoded.code[:, 0], encoded.code[:, 1]
+    rows[:n, ARG_A], rows[:n, ARG_B], rows[:n, ARG_C] = encoded.code[:, 2:5].T
+    rows[:n, VALUE] = np.arange(n)
+    registers = max(tape.n_registers, 1)
+    is_constant = np.zeros(registers, dtype=np.bool_)
+    constant_value = np.zeros(registers)
+    for c in tape.constants:
+        is_constant[c.register], constant_value[c.register] = True, c.value
+    params = encoded.params if n else np.zeros((1, 3))
+    return rows, n, int(encoded.output), params, is_constant, constant_value, encoded.inputs
+
+
+def tape_gradients(tape: Tape, xs: np.ndarray, ys: np.ndarray, zs: np.ndarray
+                   ) -> Optional[tuple[np.ndarray, np.ndarray]]:
+    """:func:`~implicitvox.eval.gradient.evaluate_gradients` of one tape, compiled
+    (bit for bit the same), or None (:func:`tape_arrays`)."""
+    arrays = tape_arrays(tape)
+    if arrays is None:
+        return None
+    rows, n, output, params, is_constant, constant_value, inputs = arrays
+    count = len(xs)
+    values, grads = np.empty(count), np.empty((3, count))
+    one = np.zeros((1, 5), dtype=np.int64)
+    one[0, START], one[0, ROWS], one[0, OUTPUT] = 0, n, output
+    registers = is_constant.size
+    _run(rows, one, params, is_constant, constant_value, inputs, np.zeros(1, dtype=np.int64),
+         np.array([count], dtype=np.int64), *(np.ascontiguousarray(v, dtype=np.float64)
+                                              for v in (xs, ys, zs)),
+         values, grads, np.empty(registers), np.empty((3, registers)))
+    return values, grads
+
+
+def crossing_points(tape: Tape, a: np.ndarray, b: np.ndarray, steps: int
+                    ) -> Optional[np.ndarray]:
+    """The bisection of :func:`implicitvox.meshing.edges.crossings` on edges
+    ``a -> b`` (n, 3), compiled (the same points, bit for bit), or None
+    (:func:`tape_arrays`)."""
+    arrays = tape_arrays(tape)
+    if arrays is None:
+        return None
+    rows, n, output, params, is_constant, constant_value, inputs = arrays
+    a = np.ascontiguousarray(a, dtype=np.float64)
+    points = np.empty_like(a)
+    registers = is_constant.size
+    _bisect(rows, n, output, params, is_constant, constant_value, inputs, a,
+            np.ascontiguousarray(b, dtype=np.float64), int(steps), points,
+            np.empty(registers), np.empty((3, registers)))
+    return points
+
+
 @njit(**COMPILE)
 def _minimum(a, b):
     """numpy's minimum (NaN propagates; of equal values, the second)."""
@@ -104,113 +168,148 @@ def _sign(a):
 
 
 @njit(**COMPILE)
+def _at_point(rows, first, length, output, params, is_constant, constant_value, inputs, x, y, z,
+              val, grad, dims):
+    """The value of the tape of rows ``first .. first + length`` at ``(x, y, z)``; its
+    gradient left in ``grad[:, output]`` with ``dims = 3`` (``dims = 0``: values only)."""
+    for f in range(is_constant.size):
+        if is_constant[f]:
+            val[f] = constant_value[f]
+            for d in range(dims):
+                grad[d, f] = 0.0
+    for axis in range(3):
+        k = inputs[axis]
+        if k >= 0:
+            val[k] = x if axis == 0 else (y if axis == 1 else z)
+            for d in range(dims):
+                grad[d, k] = 1.0 if d == axis else 0.0
+    for j in range(first, first + length):
+        row = rows[j]
+        op, o, a, b, c = row[OP], row[OUT], row[ARG_A], row[ARG_B], row[ARG_C]
+        p = params[row[VALUE]]
+        va = val[a]
+        if op == ADD:
+            out = va + val[b]
+            for d in range(dims):
+                grad[d, o] = grad[d, a] + grad[d, b]
+        elif op == SUB:
+            out = va - val[b]
+            for d in range(dims):
+                grad[d, o] = grad[d, a] - grad[d, b]
+        elif op == MUL:
+            vb = val[b]
+            out = va * vb
+            for d in range(dims):
+                grad[d, o] = grad[d, a] * vb + va * grad[d, b]
+        elif op == DIV:
+            vb = val[b]
+            out = va / vb
+            for d in range(dims):
+                grad[d, o] = (grad[d, a] - out * grad[d, b]) / vb
+        elif op == NEG:
+            out = -va
+            for d in range(dims):
+                grad[d, o] = -grad[d, a]
+        elif op == SQUARE:
+            out = va * va
+            for d in range(dims):
+                grad[d, o] = (2.0 * va) * grad[d, a]
+        elif op == SQRT:
+            out = np.sqrt(va)
+            for d in range(dims):
+                grad[d, o] = grad[d, a] / (2.0 * out)
+        elif op == ABS:
+            out = abs(va)
+            s = _sign(va)
+            for d in range(dims):
+                grad[d, o] = s * grad[d, a]
+        elif op == MIN or op == MAX:
+            vb = val[b]
+            if op == MIN:
+                out = _minimum(va, vb)
+                first_ = va <= vb
+            else:
+                out = _maximum(va, vb)
+                first_ = va >= vb
+            for d in range(dims):
+                grad[d, o] = grad[d, a] if first_ else grad[d, b]
+        elif op == ADDC:
+            out = va + p[0]
+            for d in range(dims):
+                grad[d, o] = grad[d, a]
+        elif op == RSUBC:
+            out = p[0] - va
+            for d in range(dims):
+                grad[d, o] = -grad[d, a]
+        elif op == MULC:
+            out = va * p[0]
+            for d in range(dims):
+                grad[d, o] = p[0] * grad[d, a]
+        elif op == DIVC:
+            out = va / p[0]
+            for d in range(dims):
+                grad[d, o] = grad[d, a] / p[0]
+        elif op == DISTANCE:
+            u0, u1, u2 = va - p[0], val[b] - p[1], val[c] - p[2]
+            total = u0 * u0 + u1 * u1
+            total = total + u2 * u2
+            out = np.sqrt(total)
+            for d in range(dims):
+                grad[d, o] = ((u0 * grad[d, a] + u1 * grad[d, b]) + u2 * grad[d, c]) / out
+        elif op == HYPOT:
+            vb = val[b]
+            out = math.hypot(va, vb)
+            for d in range(dims):
+                grad[d, o] = (va * grad[d, a] + vb * grad[d, b]) / out
+        elif op == RADIUS:
+            vb, vc = val[b], val[c]
+            out = math.hypot(math.hypot(va, vb), vc)
+            for d in range(dims):
+                grad[d, o] = ((va * grad[d, a] + vb * grad[d, b]) + vc * grad[d, c]) / out
+        else:                                   # FLOOR
+            out = np.floor(va)
+            for d in range(dims):
+                grad[d, o] = grad[d, a] * 0.0
+        val[o] = out
+    return val[output]
+
+
+@njit(**COMPILE)
 def _run(rows, tapes_, params, is_constant, constant_value, inputs, tapes, counts, xs, ys, zs,
          values, grads, val, grad):
-    fixed = is_constant.size
     start = 0
     for r in range(tapes.size):
         t = tapes[r]
         first, length, output = tapes_[t, START], tapes_[t, ROWS], tapes_[t, OUTPUT]
         for i in range(start, start + counts[r]):
-            for f in range(fixed):
-                if is_constant[f]:
-                    val[f] = constant_value[f]
-                    grad[0, f] = grad[1, f] = grad[2, f] = 0.0
-            for axis in range(3):
-                k = inputs[axis]
-                if k >= 0:
-                    val[k] = xs[i] if axis == 0 else (ys[i] if axis == 1 else zs[i])
-                    grad[0, k] = grad[1, k] = grad[2, k] = 0.0
-                    grad[axis, k] = 1.0
-            for j in range(first, first + length):
-                row = rows[j]
-                op, o, a, b, c = row[OP], row[OUT], row[ARG_A], row[ARG_B], row[ARG_C]
-                p = params[row[VALUE]]
-                va = val[a]
-                if op == ADD:
-                    out = va + val[b]
-                    for d in range(3):
-                        grad[d, o] = grad[d, a] + grad[d, b]
-                elif op == SUB:
-                    out = va - val[b]
-                    for d in range(3):
-                        grad[d, o] = grad[d, a] - grad[d, b]
-                elif op == MUL:
-                    vb = val[b]
-                    out = va * vb
-                    for d in range(3):
-                        grad[d, o] = grad[d, a] * vb + va * grad[d, b]
-                elif op == DIV:
-                    vb = val[b]
-                    out = va / vb
-                    for d in range(3):
-                        grad[d, o] = (grad[d, a] - out * grad[d, b]) / vb
-                elif op == NEG:
-                    out = -va
-                    for d in range(3):
-                        grad[d, o] = -grad[d, a]
-                elif op == SQUARE:
-                    out = va * va
-                    for d in range(3):
-                        grad[d, o] = (2.0 * va) * grad[d, a]
-                elif op == SQRT:
-                    out = np.sqrt(va)
-                    for d in range(3):
-                        grad[d, o] = grad[d, a] / (2.0 * out)
-                elif op == ABS:
-                    out = abs(va)
-                    s = _sign(va)
-                    for d in range(3):
-                        grad[d, o] = s * grad[d, a]
-                elif op == MIN or op == MAX:
-                    vb = val[b]
-                    if op == MIN:
-                        out = _minimum(va, vb)
-                        first_ = va <= vb
-                    else:
-                        out = _maximum(va, vb)
-                        first_ = va >= vb
-                    for d in range(3):
-                        grad[d, o] = grad[d, a] if first_ else grad[d, b]
-                elif op == ADDC:
-                    out = va + p[0]
-                    for d in range(3):
-                        grad[d, o] = grad[d, a]
-                elif op == RSUBC:
-                    out = p[0] - va
-                    for d in range(3):
-                        grad[d, o] = -grad[d, a]
-                elif op == MULC:
-                    out = va * p[0]
-                    for d in range(3):
-                        grad[d, o] = p[0] * grad[d, a]
-                elif op == DIVC:
-                    out = va / p[0]
-                    for d in range(3):
-                        grad[d, o] = grad[d, a] / p[0]
-                elif op == DISTANCE:
-                    u0, u1, u2 = va - p[0], val[b] - p[1], val[c] - p[2]
-                    total = u0 * u0 + u1 * u1
-                    total = total + u2 * u2
-                    out = np.sqrt(total)
-                    for d in range(3):
-                        grad[d, o] = ((u0 * grad[d, a] + u1 * grad[d, b]) + u2 * grad[d, c]) / out
-                elif op == HYPOT:
-                    vb = val[b]
-                    out = math.hypot(va, vb)
-                    for d in range(3):
-                        grad[d, o] = (va * grad[d, a] + vb * grad[d, b]) / out
-                elif op == RADIUS:
-                    vb, vc = val[b], val[c]
-                    out = math.hypot(math.hypot(va, vb), vc)
-                    for d in range(3):
-                        grad[d, o] = ((va * grad[d, a] + vb * grad[d, b]) + vc * grad[d, c]) / out
-                else:                                   # FLOOR
-                    out = np.floor(va)
-                    for d in range(3):
-                        grad[d, o] = grad[d, a] * 0.0
-                val[o] = out
-            values[i] = val[output]
+            values[i] = _at_point(rows, first, length, output, params, is_constant,
+                                  constant_value, inputs, xs[i], ys[i], zs[i], val, grad, 3)
             for d in range(3):
                 grads[d, i] = grad[d, output]
         start += counts[r]
+
+
+@njit(**COMPILE)
+def _bisect(rows, length, output, params, is_constant, constant_value, inputs, a, b, steps,
+            points, val, grad):
+    """:func:`implicitvox.meshing.edges.crossings`' bisection, edge by edge: the
+    bracket of the sign change on ``a[i] -> b[i]`` halved ``steps`` times, its
+    midpoint into ``points[i]`` (the same arithmetic, step for step)."""
+    for i in range(a.shape[0]):
+        d0, d1, d2 = b[i, 0] - a[i, 0], b[i, 1] - a[i, 1], b[i, 2] - a[i, 2]
+        inside_a = _at_point(rows, 0, length, output, params, is_constant, constant_value,
+                             inputs, a[i, 0], a[i, 1], a[i, 2], val, grad, 0) < 0
+        lo, hi = 0.0, 1.0
+        for _ in range(steps):
+            mid = 0.5 * (lo + hi)
+            inside = _at_point(rows, 0, length, output, params, is_constant, constant_value,
+                               inputs, a[i, 0] + mid * d0, a[i, 1] + mid * d1,
+                               a[i, 2] + mid * d2, val, grad, 0) < 0
+            if inside == inside_a:
+                lo = mid
+            else:
+                hi = mid
+        mid = 0.5 * (lo + hi)
+        points[i, 0] = a[i, 0] + mid * d0
+        points[i, 1] = a[i, 1] + mid * d1
+        points[i, 2] = a[i, 2] + mid * d2

@@ -2,7 +2,8 @@
 
 An edge whose ends have opposite signs holds a zero of ``f`` (``f`` is
 continuous there: the adaptive grid keeps only cells whose enclosure is
-defined). The zero is isolated by bisection on the signs: each step halves
+defined). The zero is isolated by bisection on the signs (in compiled code for tapes
+:mod:`implicitvox.eval.pool_gradients` runs, the same steps): each step halves
 the bracket and keeps the half whose ends still differ, so after ``steps``
 steps a zero lies in a bracket ``2**-steps`` of the edge long, whatever the
 function does between samples. A single linear interpolation of the two end
@@ -48,6 +49,12 @@ def crossings(func: Any, a: np.ndarray, b: np.ndarray, steps: int = STEPS
     n = len(a)
     if n == 0:
         return np.zeros((0, 3)), np.zeros((0, 3))
+    from ..eval.pool_gradients import crossing_points, tape_gradients   # (loads Numba)
+    compiled = crossing_points(tape, a, b, steps)
+    if compiled is not None:             # the same points and gradients, in compiled code
+        points = compiled
+        _, g = tape_gradients(tape, *points.T)
+        return points, _unit(g)
     with np.errstate(all="ignore"):
         inside_a = np.broadcast_to(evaluate_points(tape, *a.T), (n,)) < 0
         lo = np.zeros(n)
@@ -62,8 +69,14 @@ def crossings(func: Any, a: np.ndarray, b: np.ndarray, steps: int = STEPS
             hi = np.where(same, hi, mid)
         points = a + (0.5 * (lo + hi))[:, None] * d
         _, g = evaluate_gradients(tape, *points.T)
-    g = np.broadcast_to(np.asarray(g, dtype=np.float64).reshape(3, -1), (3, n)).T
+    return points, _unit(g)
+
+
+def _unit(g: np.ndarray) -> np.ndarray:
+    """Gradients ``(3, n)`` (or broadcastable) as unit rows ``(n, 3)``; zero where
+    the gradient is zero or not finite."""
+    n = np.asarray(g).reshape(3, -1).shape[1]
+    g = np.asarray(g, dtype=np.float64).reshape(3, -1).T
     norm = np.linalg.norm(g, axis=1, keepdims=True)
     with np.errstate(all="ignore"):
-        normals = np.where((norm > 0) & np.isfinite(norm), g / norm, 0.0)
-    return points, normals
+        return np.where((norm > 0) & np.isfinite(norm), g / norm, 0.0) if n else g

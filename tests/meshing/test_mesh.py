@@ -273,3 +273,28 @@ def test_pruned_tapes_give_the_same_mesh_bit_for_bit(monkeypatch):
     assert len(adaptive_grid(ivx.compile(shape.expr), grid, 0).tapes) >= 3
     assert digest(ivx.mesh(shape, resolution=64)) == \
         digest(ivx.mesh(shape, resolution=64, prune=False))
+
+
+def test_compiled_crossings_are_the_array_bisections(monkeypatch):
+    """Crossings and normals on tapes the compiled evaluator runs (CSG: min, max, abs,
+    distances, hypot) equal the array bisection's, bit for bit."""
+    from implicitvox.eval import pool_gradients
+    from implicitvox.eval.function import Function
+    from implicitvox.expr.examples import menger, sphere_union
+    from implicitvox.expr.shape import as_shape
+    from implicitvox.meshing.edges import crossings
+    blend = (csg.Box((1.2, 1.0, 0.8), center=True) - csg.Cylinder(h=2.0, r=0.3, center=True)) \
+        | csg.Sphere(0.4, center=(0.5, 0.4, 0.3))
+    rng = np.random.default_rng(2)
+    for model in (menger(2), sphere_union(12), blend):
+        func = Function(as_shape(model).expr)
+        a, b = rng.uniform(-1, 1, (2, 4000, 3))
+        crossed = (func(*a.T) < 0) != (func(*b.T) < 0)
+        a, b = a[crossed], b[crossed]
+        assert len(a) > 100
+        assert pool_gradients.tape_arrays(func.tape) is not None
+        points, normals = crossings(func, a, b)
+        with monkeypatch.context() as patched:
+            patched.setattr(pool_gradients, "crossing_points", lambda *args: None)
+            np.testing.assert_array_equal(crossings(func, a, b)[0], points)
+            np.testing.assert_array_equal(crossings(func, a, b)[1], normals)
