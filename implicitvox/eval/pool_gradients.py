@@ -1,4 +1,5 @@
-"""Values and gradients at points on the pruned tapes of a pool, in compiled code.
+"""Values and gradients at points on the pruned tapes of a pool (and on one tape), in
+compiled code.
 
 The compiled subdivision leaves each surface voxel with a tape of a
 :class:`~implicitvox.eval.tape_pool.TapePool` (thousands of short tapes on a
@@ -17,6 +18,11 @@ those IEEE 754 rounds correctly (``+ - * /``, ``sqrt``, ``min``, ``max``,
 (with ``radius``), which numpy and Numba both take from the C library. A pool
 with any other (``sin``, ``exp``, ``pow``, ...: numpy may use its own SIMD
 code) returns None, and its caller uses the array evaluator.
+
+A single :class:`~implicitvox.eval.tape.Tape` runs the same way
+(:func:`tape_arrays` lays it out as one pool tape): :func:`tape_gradients`, and
+:func:`crossing_points`, the mesher's bisection of sign changes on cell edges
+(:mod:`implicitvox.meshing.edges`), step for step.
 
 Examples
 --------
