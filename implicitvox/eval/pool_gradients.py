@@ -92,10 +92,26 @@ def pool_gradients(pool: TapePool, tapes: np.ndarray, counts: np.ndarray, xs: np
     return values, grads
 
 
+_ARRAYS: dict[int, tuple[Tape, Optional[tuple]]] = {}
+_ARRAYS_LIMIT = 4096
+
+
 def tape_arrays(tape: Tape) -> Optional[tuple]:
     """A :class:`~implicitvox.eval.tape.Tape` as one pool tape's arrays
     (``rows, length, output, params, is_constant, constant_value, inputs``), or
-    None when it holds an operation this module does not run (or a sweep)."""
+    None when it holds an operation this module does not run (or a sweep); laid
+    out once per tape object (the last :data:`_ARRAYS_LIMIT` kept)."""
+    found = _ARRAYS.get(id(tape))
+    if found is not None and found[0] is tape:
+        return found[1]
+    if len(_ARRAYS) >= _ARRAYS_LIMIT:
+        _ARRAYS.clear()
+    laid = _lay_out(tape)
+    _ARRAYS[id(tape)] = (tape, laid)          # (holding the tape keeps its id unique)
+    return laid
+
+
+def _lay_out(tape: Tape) -> Optional[tuple]:
     encoded = compiled_tape(tape)
     if encoded is None or tape.undefined or \
             not all(int(op) in POINT_OPS for op in np.unique(encoded.code[:, 0])):
