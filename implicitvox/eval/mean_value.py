@@ -29,7 +29,7 @@ from ..interval import rounding
 from .interval import apply_op, evaluate_intervals
 from .tape import Tape
 
-__all__ = ["evaluate_interval_gradients", "mean_value_enclosure"]
+__all__ = ["evaluate_interval_gradients", "array_interval_gradients", "mean_value_enclosure"]
 
 
 def evaluate_interval_gradients(tape: Tape, lo, hi):
@@ -37,7 +37,22 @@ def evaluate_interval_gradients(tape: Tape, lo, hi):
 
     Returns ``(vlo, vhi, glo, ghi, valid)``: value intervals ``(n,)``,
     gradient intervals ``(3, n)``, and where the mean value theorem holds.
+    Tapes the compiled kernel runs go there
+    (:mod:`implicitvox.eval.mean_value_kernels`: the same enclosures, bit for
+    bit), the others to :func:`array_interval_gradients`.
     """
+    if len({np.shape(c) for c in lo} | {np.shape(c) for c in hi}) == 1:
+        from .mean_value_kernels import tape_interval_gradients   # (loads Numba)
+        compiled = tape_interval_gradients(tape, lo, hi)
+        if compiled is not None:
+            return compiled
+    return array_interval_gradients(tape, lo, hi)
+
+
+def array_interval_gradients(tape: Tape, lo, hi):
+    """:func:`evaluate_interval_gradients` on the array evaluator: numpy calls per
+    instruction over every box (the oracle of the compiled kernel, and the path
+    of the tapes it does not run: libm functions, sweeps)."""
     n = lo[0].shape[0]
     valid = np.ones(n, dtype=bool)
     rv: list = [None] * tape.n_registers

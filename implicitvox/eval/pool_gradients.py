@@ -39,6 +39,7 @@ Examples
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 from typing import Optional
 
 import numpy as np
@@ -53,7 +54,7 @@ from .tape_pool import (ARG_A, ARG_B, ARG_C, OP, OUT, OUTPUT, ROW, ROWS, START, 
                         TapePool)
 
 __all__ = ["pool_gradients", "takes_pool", "tape_arrays", "tape_gradients", "crossing_points",
-           "POINT_OPS"]
+           "TapeArrays", "POINT_OPS"]
 
 #: the operations :func:`pool_gradients` runs (numbers of :data:`implicitvox.eval.compiled.OPS`)
 POINT_OPS = frozenset((ADD, SUB, MUL, DIV, NEG, SQUARE, SQRT, ABS, MIN, MAX, ADDC, RSUBC, MULC,
@@ -92,14 +93,32 @@ def pool_gradients(pool: TapePool, tapes: np.ndarray, counts: np.ndarray, xs: np
     return values, grads
 
 
-_ARRAYS: dict[int, tuple[Tape, Optional[tuple]]] = {}
+@dataclass(frozen=True)
+class TapeArrays:
+    """A tape laid out as one pool tape (:func:`tape_arrays`)."""
+
+    #: (length, ROW) int32: the pool's row layout, VALUE the row's own index
+    rows: np.ndarray
+    length: int
+    #: the output register
+    output: int
+    #: (length, 3): each row's parameters
+    params: np.ndarray
+    #: per register: a constant? its point value, and its enclosure
+    is_constant: np.ndarray
+    constant_value: np.ndarray
+    constant_lo: np.ndarray
+    constant_hi: np.ndarray
+    #: (3,) the registers of x, y, z (-1: unused)
+    inputs: np.ndarray
+
+
+_ARRAYS: dict[int, tuple[Tape, Optional[TapeArrays]]] = {}
 _ARRAYS_LIMIT = 4096
 
 
-def tape_arrays(tape: Tape) -> Optional[tuple]:
-    """A :class:`~implicitvox.eval.tape.Tape` as one pool tape's arrays
-    (``rows, length, output, params, is_constant, constant_value, inputs``), or
-    None when it holds an operation this module does not run (or a sweep); laid
+def tape_arrays(tape: Tape) -> Optional[TapeArrays]:
+    """A :class:`~implicitvox.eval.tape.Tape` as one pool tape's arrays, or None when it holds an operation this module does not run (or a sweep); laid
     out once per tape object (the last :data:`_ARRAYS_LIMIT` kept)."""
     found = _ARRAYS.get(id(tape))
     if found is not None and found[0] is tape:
@@ -111,7 +130,7 @@ def tape_arrays(tape: Tape) -> Optional[tuple]:
     return laid
 
 
-def _lay_out(tape: Tape) -> Optional[tuple]:
+def _lay_out(tape: Tape) -> Optional[TapeArrays]:
     encoded = compiled_tape(tape)
     if encoded is None or tape.undefined or \
             not all(int(op) in POINT_OPS for op in np.unique(encoded.code[:, 0])):
@@ -124,10 +143,13 @@ def _lay_out(tape: Tape) -> Optional[tuple]:
     registers = max(tape.n_registers, 1)
     is_constant = np.zeros(registers, dtype=np.bool_)
     constant_value = np.zeros(registers)
+    constant_lo, constant_hi = np.zeros(registers), np.zeros(registers)
     for c in tape.constants:
         is_constant[c.register], constant_value[c.register] = True, c.value
+        constant_lo[c.register], constant_hi[c.register] = c.lo, c.hi
     params = encoded.params if n else np.zeros((1, 3))
-    return rows, n, int(encoded.output), params, is_constant, constant_value, encoded.inputs
+    return TapeArrays(rows, n, int(encoded.output), params, is_constant, constant_value,
+                      constant_lo, constant_hi, encoded.inputs)
 
 
 def tape_gradients(tape: Tape, xs: np.ndarray, ys: np.ndarray, zs: np.ndarray
@@ -137,7 +159,8 @@ def tape_gradients(tape: Tape, xs: np.ndarray, ys: np.ndarray, zs: np.ndarray
     arrays = tape_arrays(tape)
     if arrays is None:
         return None
-    rows, n, output, params, is_constant, constant_value, inputs = arrays
+    rows, n, output, params = arrays.rows, arrays.length, arrays.output, arrays.params
+    is_constant, constant_value, inputs = arrays.is_constant, arrays.constant_value, arrays.inputs
     count = len(xs)
     values, grads = np.empty(count), np.empty((3, count))
     one = np.zeros((1, 5), dtype=np.int64)
@@ -158,7 +181,8 @@ def crossing_points(tape: Tape, a: np.ndarray, b: np.ndarray, steps: int
     arrays = tape_arrays(tape)
     if arrays is None:
         return None
-    rows, n, output, params, is_constant, constant_value, inputs = arrays
+    rows, n, output, params = arrays.rows, arrays.length, arrays.output, arrays.params
+    is_constant, constant_value, inputs = arrays.is_constant, arrays.constant_value, arrays.inputs
     a = np.ascontiguousarray(a, dtype=np.float64)
     points = np.empty_like(a)
     registers = is_constant.size
