@@ -127,7 +127,9 @@ def encode(tape: Tape) -> Optional[CompiledTape]:
 
 
 _ENCODED: dict[int, tuple[Tape, Optional[CompiledTape]]] = {}
-_ENCODED_LIMIT = 4096
+#: (the mesher runs each cell's tape several times, and the level-3 sponge at 256 has
+#: about 18,000 of them: a smaller cache emptied and refilled itself)
+_ENCODED_LIMIT = 1 << 16
 
 
 def compiled_tape(tape: Tape) -> Optional[CompiledTape]:

@@ -114,7 +114,9 @@ class TapeArrays:
 
 
 _ARRAYS: dict[int, tuple[Tape, Optional[TapeArrays]]] = {}
-_ARRAYS_LIMIT = 4096
+#: (the mesher runs each cell's tape several times, and the level-3 sponge at 256 has
+#: about 18,000 of them: a smaller cache emptied and refilled itself)
+_ARRAYS_LIMIT = 1 << 16
 
 
 def tape_arrays(tape: Tape) -> Optional[TapeArrays]:
