@@ -41,7 +41,8 @@ from ..interval.rules import (COMPILE, i_abs, i_acos, i_add, i_addc, i_asin, i_a
 from .pruning import FIRST, RELATIVE_GAP, SECOND
 from .tape import Tape
 
-__all__ = ["CompiledTape", "encode", "compiled_tape", "evaluate_boxes", "run_row", "is_domain",
+__all__ = ["CompiledTape", "encode", "compiled_tape", "once_per_tape", "evaluate_boxes", "run_row",
+           "is_domain",
            "OPS", "BLOCK"]
 
 #: boxes per block: each instruction runs over a block before the next one (its
@@ -134,14 +135,20 @@ _ENCODED_LIMIT = 1 << 16
 
 def compiled_tape(tape: Tape) -> Optional[CompiledTape]:
     """:func:`encode`, once per tape object (the last :data:`_ENCODED_LIMIT` kept)."""
-    found = _ENCODED.get(id(tape))
+    return once_per_tape(_ENCODED, _ENCODED_LIMIT, tape, encode)
+
+
+def once_per_tape(cache: dict, limit: int, tape: Tape, build):
+    """``build(tape)``, kept in ``cache`` by the tape object (emptied past ``limit``
+    entries; holding the tape keeps its id unique)."""
+    found = cache.get(id(tape))
     if found is not None and found[0] is tape:
         return found[1]
-    if len(_ENCODED) >= _ENCODED_LIMIT:
-        _ENCODED.clear()
-    encoded = encode(tape)
-    _ENCODED[id(tape)] = (tape, encoded)      # (holding the tape keeps its id unique)
-    return encoded
+    if len(cache) >= limit:
+        cache.clear()
+    built = build(tape)
+    cache[id(tape)] = (tape, built)
+    return built
 
 
 def evaluate_boxes(tape: CompiledTape, lo: np.ndarray, hi: np.ndarray,

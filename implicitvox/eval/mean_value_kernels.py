@@ -36,7 +36,7 @@ from ..interval.rules import (COMPILE, i_abs, i_add, i_addc, i_distance, i_div, 
                               i_rsubc, i_sqrt, i_square, i_sub)
 from .compiled import (ABS, ADD, ADDC, DISTANCE, DIV, DIVC, FLOOR, HYPOT, MAX, MIN, MUL, MULC,
                        NEG, RADIUS, RSUBC, SQRT, SQUARE, SUB)
-from .pool_gradients import tape_arrays
+from .pool_gradients import numpy_maximum, numpy_minimum, tape_arrays
 from .tape import Tape
 from .tape_pool import ARG_A, ARG_B, ARG_C, OP, OUT, VALUE
 
@@ -63,17 +63,6 @@ def tape_interval_gradients(tape: Tape, lo, hi) -> Optional[tuple]:
          valid, np.empty(registers), np.empty(registers), np.empty((3, registers)),
          np.empty((3, registers)))
     return vlo, vhi, glo, ghi, valid
-
-
-@njit(**COMPILE)
-def _minimum(a, b):
-    """numpy's minimum (NaN propagates; of equal values, the second)."""
-    return a if (a < b or a != a) else b
-
-
-@njit(**COMPILE)
-def _maximum(a, b):
-    return a if (a > b or a != a) else b
 
 
 @njit(**COMPILE)
@@ -138,7 +127,7 @@ def _run(rows, length, output, params, is_constant, constant_lo, constant_hi, in
                 ol, oh = i_abs(al, ah)
                 for d in range(3):
                     g0, g1 = gl[d, a], gh[d, a]
-                    m = _maximum(-g0, g1)
+                    m = numpy_maximum(-g0, g1)
                     if al >= 0.0:
                         gl[d, o], gh[d, o] = g0, g1
                     elif ah <= 0.0:
@@ -159,8 +148,8 @@ def _run(rows, length, output, params, is_constant, constant_lo, constant_hi, in
                     elif b_wins:
                         gl[d, o], gh[d, o] = gl[d, b], gh[d, b]
                     else:
-                        gl[d, o] = _minimum(gl[d, a], gl[d, b])
-                        gh[d, o] = _maximum(gh[d, a], gh[d, b])
+                        gl[d, o] = numpy_minimum(gl[d, a], gl[d, b])
+                        gh[d, o] = numpy_maximum(gh[d, a], gh[d, b])
             elif op == ADDC:
                 ol, oh = i_addc(al, ah, p[0])
                 for d in range(3):

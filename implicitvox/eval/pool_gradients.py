@@ -46,7 +46,7 @@ import numpy as np
 from numba import njit
 
 from ..interval.rules import COMPILE
-from .compiled import compiled_tape
+from .compiled import compiled_tape, once_per_tape
 from .compiled import (ABS, ADD, ADDC, DISTANCE, DIV, DIVC, FLOOR, HYPOT, MAX, MIN, MUL, MULC,
                        NEG, RADIUS, RSUBC, SQRT, SQUARE, SUB)
 from .tape import Tape
@@ -54,7 +54,7 @@ from .tape_pool import (ARG_A, ARG_B, ARG_C, OP, OUT, OUTPUT, ROW, ROWS, START, 
                         TapePool)
 
 __all__ = ["pool_gradients", "takes_pool", "tape_arrays", "tape_gradients", "crossing_points",
-           "TapeArrays", "POINT_OPS"]
+           "TapeArrays", "POINT_OPS", "numpy_minimum", "numpy_maximum"]
 
 #: the operations :func:`pool_gradients` runs (numbers of :data:`implicitvox.eval.compiled.OPS`)
 POINT_OPS = frozenset((ADD, SUB, MUL, DIV, NEG, SQUARE, SQRT, ABS, MIN, MAX, ADDC, RSUBC, MULC,
@@ -122,14 +122,7 @@ _ARRAYS_LIMIT = 1 << 16
 def tape_arrays(tape: Tape) -> Optional[TapeArrays]:
     """A :class:`~implicitvox.eval.tape.Tape` as one pool tape's arrays, or None when it holds an operation this module does not run (or a sweep); laid
     out once per tape object (the last :data:`_ARRAYS_LIMIT` kept)."""
-    found = _ARRAYS.get(id(tape))
-    if found is not None and found[0] is tape:
-        return found[1]
-    if len(_ARRAYS) >= _ARRAYS_LIMIT:
-        _ARRAYS.clear()
-    laid = _lay_out(tape)
-    _ARRAYS[id(tape)] = (tape, laid)          # (holding the tape keeps its id unique)
-    return laid
+    return once_per_tape(_ARRAYS, _ARRAYS_LIMIT, tape, _lay_out)
 
 
 def _lay_out(tape: Tape) -> Optional[TapeArrays]:
@@ -195,13 +188,14 @@ def crossing_points(tape: Tape, a: np.ndarray, b: np.ndarray, steps: int
 
 
 @njit(**COMPILE)
-def _minimum(a, b):
+def numpy_minimum(a, b):
     """numpy's minimum (NaN propagates; of equal values, the second)."""
     return a if (a < b or a != a) else b
 
 
 @njit(**COMPILE)
-def _maximum(a, b):
+def numpy_maximum(a, b):
+    """numpy's maximum (NaN propagates; of equal values, the second)."""
     return a if (a > b or a != a) else b
 
 
@@ -274,10 +268,10 @@ def _at_point(rows, first, length, output, params, is_constant, constant_value, 
         elif op == MIN or op == MAX:
             vb = val[b]
             if op == MIN:
-                out = _minimum(va, vb)
+                out = numpy_minimum(va, vb)
                 first_ = va <= vb
             else:
-                out = _maximum(va, vb)
+                out = numpy_maximum(va, vb)
                 first_ = va >= vb
             for d in range(dims):
                 grad[d, o] = grad[d, a] if first_ else grad[d, b]
