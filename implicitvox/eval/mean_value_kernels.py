@@ -66,6 +66,20 @@ def tape_interval_gradients(tape: Tape, lo, hi) -> Optional[tuple]:
 
 
 @njit(**COMPILE)
+def _chain3(ul, uh, vl, vh, wl, wh, a, b, c, o, ol, oh, gl, gh):
+    """The gradient of a distance ``out`` from its offsets ``u, v, w`` along the
+    arguments ``a, b, c``: ``((u ga + v gb) + w gc) / out`` (derivatives.d_distance,
+    d_radius), into register ``o``."""
+    for d in range(3):
+        l0, h0 = i_mul(ul, uh, gl[d, a], gh[d, a])
+        l1, h1 = i_mul(vl, vh, gl[d, b], gh[d, b])
+        l2, h2 = i_mul(wl, wh, gl[d, c], gh[d, c])
+        l0, h0 = i_add(l0, h0, l1, h1)
+        l0, h0 = i_add(l0, h0, l2, h2)
+        gl[d, o], gh[d, o] = i_div(l0, h0, ol, oh)
+
+
+@njit(**COMPILE)
 def _run(rows, length, output, params, is_constant, constant_lo, constant_hi, inputs, lo, hi,
          vlo, vhi, glo, ghi, valid, rl, rh, gl, gh):
     for i in range(lo.shape[1]):
@@ -172,13 +186,7 @@ def _run(rows, length, output, params, is_constant, constant_lo, constant_hi, in
                 x0l, x0h = i_addc(al, ah, -p[0])
                 x1l, x1h = i_addc(bl, bh, -p[1])
                 x2l, x2h = i_addc(cl, ch, -p[2])
-                for d in range(3):
-                    l0, h0 = i_mul(x0l, x0h, gl[d, a], gh[d, a])
-                    l1, h1 = i_mul(x1l, x1h, gl[d, b], gh[d, b])
-                    l2, h2 = i_mul(x2l, x2h, gl[d, c], gh[d, c])
-                    l0, h0 = i_add(l0, h0, l1, h1)
-                    l0, h0 = i_add(l0, h0, l2, h2)
-                    gl[d, o], gh[d, o] = i_div(l0, h0, ol, oh)
+                _chain3(x0l, x0h, x1l, x1h, x2l, x2h, a, b, c, o, ol, oh, gl, gh)
             elif op == HYPOT:
                 bl, bh = rl[b], rh[b]
                 ol, oh = i_hypot(al, ah, bl, bh)
@@ -190,13 +198,7 @@ def _run(rows, length, output, params, is_constant, constant_lo, constant_hi, in
             elif op == RADIUS:
                 bl, bh, cl, ch = rl[b], rh[b], rl[c], rh[c]
                 ol, oh = i_radius(al, ah, bl, bh, cl, ch)
-                for d in range(3):
-                    l0, h0 = i_mul(al, ah, gl[d, a], gh[d, a])
-                    l1, h1 = i_mul(bl, bh, gl[d, b], gh[d, b])
-                    l2, h2 = i_mul(cl, ch, gl[d, c], gh[d, c])
-                    l0, h0 = i_add(l0, h0, l1, h1)
-                    l0, h0 = i_add(l0, h0, l2, h2)
-                    gl[d, o], gh[d, o] = i_div(l0, h0, ol, oh)
+                _chain3(al, ah, bl, bh, cl, ch, a, b, c, o, ol, oh, gl, gh)
             else:                                   # FLOOR
                 ol, oh = i_floor(al, ah)
                 ok = ok and np.floor(al) == np.floor(ah)
