@@ -3,15 +3,24 @@
 :func:`implicitvox.eval.mean_value.evaluate_interval_gradients` runs a tape's
 interval chain rules (:mod:`implicitvox.interval.derivatives`) as numpy calls
 over small batches of boxes; the mesher asks it for thousands of pruned tapes,
-a few boxes each, and the Python around each call costs more than the
-arithmetic. :func:`tape_interval_gradients` runs the same rules box by box in
-Numba, on the compiled interval rules (:mod:`implicitvox.interval.rules`, bit
-for bit the array kernels), for the tapes
-:mod:`implicitvox.eval.pool_gradients` lays out (correctly rounded operations,
-``min``, ``max``, ``abs``, ``floor`` and the distance forms): the same
-enclosures, bit for bit, and the same lanes where the mean value theorem fails
-(a ``sqrt`` at or below 0, a ``floor`` jump). Other tapes get None, and the
-array code runs.
+a few boxes each, and the certified distance search for millions of boxes, and
+the Python around each call costs more than the arithmetic.
+:func:`tape_interval_gradients` runs the same rules box by box in Numba, on the
+compiled interval rules (:mod:`implicitvox.interval.rules`, the one compiled
+source of every interval rule), with the same lanes where the mean value
+theorem fails (a domain boundary, a pole, the ``atan2`` cut, a ``floor`` jump).
+
+By default it takes the tapes whose enclosures cannot depend on whose code
+computes them (the operations of
+:data:`implicitvox.eval.pool_gradients.POINT_OPS`: correctly rounded
+arithmetic, ``min``, ``max``, ``abs``, ``floor``, ``hypot`` and the distance
+forms), and its enclosures equal the array evaluator's bit for bit; others get
+None, and the array code runs. With ``libm=True`` it takes every tape compiled
+code runs (``sin``, ``exp``, ``atan2``, the coordinate forms, ...): the rules
+whose compiled and array kernels call different libm code (``sin``, ``cos``,
+the periodic angle) then give enclosures that differ from the array
+evaluator's in the last bits, each rounded outward by its own kernel's
+measured error (:mod:`implicitvox.interval.rounding`).
 
 Examples
 --------
@@ -31,25 +40,31 @@ from typing import Optional
 import numpy as np
 from numba import njit
 
-from ..interval.rules import (COMPILE, i_abs, i_add, i_addc, i_distance, i_div, i_divc,
-                              i_floor, i_hypot, i_max, i_min, i_mul, i_mulc, i_neg, i_radius,
-                              i_rsubc, i_sqrt, i_square, i_sub)
-from .compiled import (ABS, ADD, ADDC, DISTANCE, DIV, DIVC, FLOOR, HYPOT, MAX, MIN, MUL, MULC,
-                       NEG, RADIUS, RSUBC, SQRT, SQUARE, SUB)
-from .pool_gradients import numpy_maximum, numpy_minimum, tape_arrays
+from ..interval.rules import (COMPILE, i_abs, i_acos, i_add, i_addc, i_asin, i_atan, i_atan2,
+                              i_cos, i_distance, i_div, i_divc, i_elevation, i_exp, i_floor,
+                              i_hypot, i_log, i_max, i_min, i_mul, i_mulc, i_neg,
+                              i_periodic_angle, i_powi, i_powr, i_radius, i_rsubc, i_sin, i_sqrt,
+                              i_square, i_sub, i_tan)
+from .compiled import (ABS, ACOS, ADD, ADDC, ASIN, ATAN, ATAN2, COS, DISTANCE, DIV, DIVC,
+                       ELEVATION, EXP, FLOOR, HYPOT, LOG, MAX, MIN, MUL, MULC, NEG,
+                       PERIODIC_ANGLE, POWI, POWR, RADIUS, RSUBC, SIN, SQRT, SQUARE, SUB, TAN, compiled_tape)
+from .pool_gradients import POINT_OPS, numpy_maximum, numpy_minimum
 from .tape import Tape
-from .tape_pool import ARG_A, ARG_B, ARG_C, OP, OUT, VALUE
 
 __all__ = ["tape_interval_gradients"]
 
 
-def tape_interval_gradients(tape: Tape, lo, hi) -> Optional[tuple]:
+def tape_interval_gradients(tape: Tape, lo, hi, *, libm: bool = False) -> Optional[tuple]:
     """:func:`~implicitvox.eval.mean_value.evaluate_interval_gradients` of ``tape``
     over the boxes ``lo, hi`` (sequences of 3 arrays ``(n,)``, or ``(3, n)``), in
     compiled code: ``(vlo, vhi, glo, ghi, valid)``; None for a tape it does not
-    run."""
-    arrays = tape_arrays(tape)
-    if arrays is None:
+    run (a sweep, an undefined tape, or, unless ``libm``, an operation outside
+    :data:`~implicitvox.eval.pool_gradients.POINT_OPS`: see the module
+    docstring)."""
+    encoded = compiled_tape(tape)
+    if encoded is None or tape.undefined:
+        return None
+    if not libm and not all(int(op) in POINT_OPS for op in np.unique(encoded.code[:, 0])):
         return None
     lo = np.ascontiguousarray(np.asarray(lo, dtype=np.float64).reshape(3, -1))
     hi = np.ascontiguousarray(np.asarray(hi, dtype=np.float64).reshape(3, -1))
@@ -57,11 +72,11 @@ def tape_interval_gradients(tape: Tape, lo, hi) -> Optional[tuple]:
     vlo, vhi = np.empty(n), np.empty(n)
     glo, ghi = np.empty((3, n)), np.empty((3, n))
     valid = np.ones(n, dtype=np.bool_)
-    registers = arrays.is_constant.size
-    _run(arrays.rows, arrays.length, arrays.output, arrays.params, arrays.is_constant,
-         arrays.constant_lo, arrays.constant_hi, arrays.inputs, lo, hi, vlo, vhi, glo, ghi,
-         valid, np.empty(registers), np.empty(registers), np.empty((3, registers)),
-         np.empty((3, registers)))
+    registers = max(encoded.n_registers, 1)
+    run_gradients(encoded.code, encoded.params, encoded.constant_registers, encoded.constant_lo,
+                  encoded.constant_hi, encoded.inputs, encoded.output, lo, hi, vlo, vhi, glo,
+                  ghi, valid, np.empty(registers), np.empty(registers),
+                  np.empty((3, registers)), np.empty((3, registers)))
     return vlo, vhi, glo, ghi, valid
 
 
@@ -80,25 +95,55 @@ def _chain3(ul, uh, vl, vh, wl, wh, a, b, c, o, ol, oh, gl, gh):
 
 
 @njit(**COMPILE)
-def _run(rows, length, output, params, is_constant, constant_lo, constant_hi, inputs, lo, hi,
-         vlo, vhi, glo, ghi, valid, rl, rh, gl, gh):
+def _scale(sl, sh, a, o, gl, gh):
+    """``g_o = [s] * g_a``: the chain rule of a function of one argument."""
+    for d in range(3):
+        gl[d, o], gh[d, o] = i_mul(sl, sh, gl[d, a], gh[d, a])
+
+
+@njit(**COMPILE)
+def _angle_rate(yl, yh, xl, xh, a_y, a_x, scaled, sl, sh, o, gl, gh):
+    """``g_o = (x g_y - y g_x) / (x² + y²)``, the chain rule through the angle
+    ``atan2(y, x)`` (derivatives.d_atan2), times ``[s]`` if ``scaled``
+    (derivatives.d_periodic_angle)."""
+    dl, dh = i_add(*i_square(xl, xh), *i_square(yl, yh))
+    for d in range(3):
+        l0, h0 = i_mul(xl, xh, gl[d, a_y], gh[d, a_y])
+        l1, h1 = i_mul(yl, yh, gl[d, a_x], gh[d, a_x])
+        l0, h0 = i_div(*i_sub(l0, h0, l1, h1), dl, dh)
+        gl[d, o], gh[d, o] = i_mul(sl, sh, l0, h0) if scaled else (l0, h0)
+
+
+@njit(**COMPILE)
+def _holds_origin(al, ah, bl, bh):
+    return al <= 0.0 and ah >= 0.0 and bl <= 0.0 and bh >= 0.0
+
+
+@njit(**COMPILE)
+def run_gradients(code, params, creg, clo, chi, inputs, output, lo, hi, vlo, vhi, glo, ghi,
+                  valid, rl, rh, gl, gh):
+    """Box by box, each instruction's value enclosure (its rule of
+    :mod:`implicitvox.interval.rules`) and gradient enclosure (the chain rule of
+    :mod:`implicitvox.interval.derivatives`, written with the same rules), over the
+    rows of a :class:`~implicitvox.eval.compiled.CompiledTape`; ``valid`` is False
+    where the mean value theorem fails over the box or a domain operation's
+    argument lies wholly outside its domain."""
     for i in range(lo.shape[1]):
         ok = True
-        for f in range(is_constant.size):
-            if is_constant[f]:
-                rl[f], rh[f] = constant_lo[f], constant_hi[f]
-                for d in range(3):
-                    gl[d, f] = gh[d, f] = 0.0
+        for k in range(creg.size):
+            f = creg[k]
+            rl[f], rh[f] = clo[k], chi[k]
+            for d in range(3):
+                gl[d, f] = gh[d, f] = 0.0
         for axis in range(3):
             k = inputs[axis]
             if k >= 0:
                 rl[k], rh[k] = lo[axis, i], hi[axis, i]
                 for d in range(3):
                     gl[d, k] = gh[d, k] = 1.0 if d == axis else 0.0
-        for j in range(length):
-            row = rows[j]
-            op, o, a, b, c = row[OP], row[OUT], row[ARG_A], row[ARG_B], row[ARG_C]
-            p = params[row[VALUE]]
+        for j in range(code.shape[0]):
+            op, o, a, b, c = code[j, 0], code[j, 1], code[j, 2], code[j, 3], code[j, 4]
+            p0 = params[j, 0]
             al, ah = rl[a], rh[a]
             if op == ADD:
                 ol, oh = i_add(al, ah, rl[b], rh[b])
@@ -128,15 +173,85 @@ def _run(rows, length, output, params, is_constant, constant_lo, constant_hi, in
                     gl[d, o], gh[d, o] = i_neg(gl[d, a], gh[d, a])
             elif op == SQUARE:
                 ol, oh = i_square(al, ah)
-                tl, th = i_mulc(al, ah, 2.0)
-                for d in range(3):
-                    gl[d, o], gh[d, o] = i_mul(tl, th, gl[d, a], gh[d, a])
+                _scale(*i_mulc(al, ah, 2.0), a, o, gl, gh)
+            elif op == POWI:
+                n = int(p0)
+                ol, oh = i_powi(al, ah, n)
+                if n == 0:
+                    for d in range(3):
+                        gl[d, o] = gh[d, o] = 0.0
+                else:
+                    _scale(*i_mulc(*i_powi(al, ah, n - 1), p0), a, o, gl, gh)
+            elif op == POWR:
+                ol, oh, empty = i_powr(al, ah, p0)
+                ok = ok and not empty and al > 0.0
+                sl, sh, _ = i_powr(al, ah, p0 - 1.0)
+                _scale(*i_mulc(sl, sh, p0), a, o, gl, gh)
             elif op == SQRT:
                 ol, oh, empty = i_sqrt(al, ah)
                 ok = ok and not empty and al > 0.0
                 tl, th = i_mulc(ol, oh, 2.0)
                 for d in range(3):
                     gl[d, o], gh[d, o] = i_div(gl[d, a], gh[d, a], tl, th)
+            elif op == EXP:
+                ol, oh = i_exp(al, ah)
+                _scale(ol, oh, a, o, gl, gh)
+            elif op == LOG:
+                ol, oh, empty = i_log(al, ah)
+                ok = ok and not empty and al > 0.0
+                for d in range(3):
+                    gl[d, o], gh[d, o] = i_div(gl[d, a], gh[d, a], al, ah)
+            elif op == SIN:
+                ol, oh = i_sin(al, ah)
+                _scale(*i_cos(al, ah), a, o, gl, gh)
+            elif op == COS:
+                ol, oh = i_cos(al, ah)
+                _scale(*i_neg(*i_sin(al, ah)), a, o, gl, gh)
+            elif op == TAN:
+                ol, oh = i_tan(al, ah)
+                ok = ok and np.isfinite(ol) and np.isfinite(oh)
+                _scale(*i_addc(*i_square(ol, oh), 1.0), a, o, gl, gh)
+            elif op == ATAN:
+                ol, oh = i_atan(al, ah)
+                tl, th = i_addc(*i_square(al, ah), 1.0)
+                for d in range(3):
+                    gl[d, o], gh[d, o] = i_div(gl[d, a], gh[d, a], tl, th)
+            elif op == ASIN or op == ACOS:
+                if op == ASIN:
+                    ol, oh, empty = i_asin(al, ah)
+                else:
+                    ol, oh, empty = i_acos(al, ah)
+                ok = ok and not empty and al > -1.0 and ah < 1.0
+                tl, th, _ = i_sqrt(*i_rsubc(*i_square(al, ah), 1.0))
+                for d in range(3):
+                    l0, h0 = i_div(gl[d, a], gh[d, a], tl, th)
+                    gl[d, o], gh[d, o] = (l0, h0) if op == ASIN else i_neg(l0, h0)
+            elif op == ATAN2:
+                bl, bh = rl[b], rh[b]
+                ol, oh = i_atan2(al, ah, bl, bh)
+                ok = ok and not (bl <= 0.0 and al <= 0.0 and ah >= 0.0)
+                _angle_rate(al, ah, bl, bh, a, b, False, 1.0, 1.0, o, gl, gh)
+            elif op == PERIODIC_ANGLE:
+                bl, bh = rl[b], rh[b]
+                k, phase = params[j, 1], params[j, 2]
+                ol, oh = i_periodic_angle(al, ah, bl, bh, p0, k, phase)
+                ok = ok and not _holds_origin(al, ah, bl, bh)
+                sl, sh = i_periodic_angle(al, ah, bl, bh, 1.0 - p0, k, phase)
+                if p0 == 1.0:                            # cos: the slope is -sin
+                    sl, sh = i_neg(sl, sh)
+                _angle_rate(al, ah, bl, bh, a, b, True, *i_mulc(sl, sh, k), o, gl, gh)
+            elif op == ELEVATION:
+                bl, bh, cl, ch = rl[b], rh[b], rl[c], rh[c]
+                ol, oh = i_elevation(al, ah, bl, bh, cl, ch)
+                ok = ok and not (_holds_origin(al, ah, bl, bh) and cl <= 0.0 and ch >= 0.0)
+                ql, qh = i_hypot(al, ah, bl, bh)
+                dl, dh = i_add(*i_square(ql, qh), *i_square(cl, ch))
+                for d in range(3):
+                    l0, h0 = i_mul(al, ah, gl[d, a], gh[d, a])
+                    l1, h1 = i_mul(bl, bh, gl[d, b], gh[d, b])
+                    l0, h0 = i_div(*i_add(l0, h0, l1, h1), ql, qh)          # d rho
+                    l1, h1 = i_sub(*i_mul(ql, qh, gl[d, c], gh[d, c]), *i_mul(cl, ch, l0, h0))
+                    gl[d, o], gh[d, o] = i_div(l1, h1, dl, dh)
             elif op == ABS:
                 ol, oh = i_abs(al, ah)
                 for d in range(3):
@@ -165,27 +280,27 @@ def _run(rows, length, output, params, is_constant, constant_lo, constant_hi, in
                         gl[d, o] = numpy_minimum(gl[d, a], gl[d, b])
                         gh[d, o] = numpy_maximum(gh[d, a], gh[d, b])
             elif op == ADDC:
-                ol, oh = i_addc(al, ah, p[0])
+                ol, oh = i_addc(al, ah, p0)
                 for d in range(3):
                     gl[d, o], gh[d, o] = gl[d, a], gh[d, a]
             elif op == RSUBC:
-                ol, oh = i_rsubc(al, ah, p[0])
+                ol, oh = i_rsubc(al, ah, p0)
                 for d in range(3):
                     gl[d, o], gh[d, o] = i_neg(gl[d, a], gh[d, a])
             elif op == MULC:
-                ol, oh = i_mulc(al, ah, p[0])
+                ol, oh = i_mulc(al, ah, p0)
                 for d in range(3):
-                    gl[d, o], gh[d, o] = i_mulc(gl[d, a], gh[d, a], p[0])
+                    gl[d, o], gh[d, o] = i_mulc(gl[d, a], gh[d, a], p0)
             elif op == DIVC:
-                ol, oh = i_divc(al, ah, p[0])
+                ol, oh = i_divc(al, ah, p0)
                 for d in range(3):
-                    gl[d, o], gh[d, o] = i_divc(gl[d, a], gh[d, a], p[0])
+                    gl[d, o], gh[d, o] = i_divc(gl[d, a], gh[d, a], p0)
             elif op == DISTANCE:
                 bl, bh, cl, ch = rl[b], rh[b], rl[c], rh[c]
-                ol, oh = i_distance(al, ah, bl, bh, cl, ch, p[0], p[1], p[2])
-                x0l, x0h = i_addc(al, ah, -p[0])
-                x1l, x1h = i_addc(bl, bh, -p[1])
-                x2l, x2h = i_addc(cl, ch, -p[2])
+                ol, oh = i_distance(al, ah, bl, bh, cl, ch, p0, params[j, 1], params[j, 2])
+                x0l, x0h = i_addc(al, ah, -p0)
+                x1l, x1h = i_addc(bl, bh, -params[j, 1])
+                x2l, x2h = i_addc(cl, ch, -params[j, 2])
                 _chain3(x0l, x0h, x1l, x1h, x2l, x2h, a, b, c, o, ol, oh, gl, gh)
             elif op == HYPOT:
                 bl, bh = rl[b], rh[b]
