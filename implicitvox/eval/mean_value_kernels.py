@@ -30,7 +30,7 @@ Examples
 >>> tape = build_tape(sqrt(x * x + y * y + z * z) - 1.0)
 >>> lo, hi = np.array([[3.0], [0.0], [4.0]]), np.array([[3.5], [0.5], [4.5]])
 >>> vlo, vhi, glo, ghi, valid = tape_interval_gradients(tape, lo, hi)
->>> bool(vlo[0] <= 4.0 and vhi[0] >= 5.0 - 1.0), bool(glo[0, 0] <= 0.6 <= ghi[0, 0]), valid.tolist()
+>>> bool(vlo[0] <= 4.0 <= vhi[0]), bool(glo[0, 0] <= 0.6 <= ghi[0, 0]), valid.tolist()
 (True, True, [True])
 """
 from __future__ import annotations
@@ -47,20 +47,31 @@ from ..interval.rules import (COMPILE, i_abs, i_acos, i_add, i_addc, i_asin, i_a
                               i_square, i_sub, i_tan)
 from .compiled import (ABS, ACOS, ADD, ADDC, ASIN, ATAN, ATAN2, COS, DISTANCE, DIV, DIVC,
                        ELEVATION, EXP, FLOOR, HYPOT, LOG, MAX, MIN, MUL, MULC, NEG,
-                       PERIODIC_ANGLE, POWI, POWR, RADIUS, RSUBC, SIN, SQRT, SQUARE, SUB, TAN, compiled_tape)
+                       PERIODIC_ANGLE, POWI, POWR, RADIUS, RSUBC, SIN, SQRT, SQUARE, SUB, TAN,
+                       compiled_tape)
 from .pool_gradients import POINT_OPS, numpy_maximum, numpy_minimum
 from .tape import Tape
 
 __all__ = ["tape_interval_gradients"]
 
 
-def tape_interval_gradients(tape: Tape, lo, hi, *, libm: bool = False) -> Optional[tuple]:
+def tape_interval_gradients(tape: Tape, lo, hi, *, libm: bool = False, closed: bool = False
+                            ) -> Optional[tuple]:
     """:func:`~implicitvox.eval.mean_value.evaluate_interval_gradients` of ``tape``
     over the boxes ``lo, hi`` (sequences of 3 arrays ``(n,)``, or ``(3, n)``), in
     compiled code: ``(vlo, vhi, glo, ghi, valid)``; None for a tape it does not
     run (a sweep, an undefined tape, or, unless ``libm``, an operation outside
     :data:`~implicitvox.eval.pool_gradients.POINT_OPS`: see the module
-    docstring)."""
+    docstring).
+
+    The gradient enclosure holds the (Clarke generalized) gradients wherever the
+    mean value theorem needs them: on the open segments between points of the
+    box. With ``closed=True`` it holds them at every point of the closed box, and a
+    box is valid only where ``f`` is Lipschitz around each of its points: an
+    ``abs`` whose argument touches 0 on a face takes the hull of both sides, and a
+    ``floor`` with a jump on a face makes the box invalid (the certified distance
+    search prunes boxes by the gradients at their points).
+    """
     encoded = compiled_tape(tape)
     if encoded is None or tape.undefined:
         return None
@@ -75,7 +86,7 @@ def tape_interval_gradients(tape: Tape, lo, hi, *, libm: bool = False) -> Option
     registers = max(encoded.n_registers, 1)
     run_gradients(encoded.code, encoded.params, encoded.constant_registers, encoded.constant_lo,
                   encoded.constant_hi, encoded.inputs, encoded.output, lo, hi, vlo, vhi, glo,
-                  ghi, valid, np.empty(registers), np.empty(registers),
+                  ghi, valid, closed, np.empty(registers), np.empty(registers),
                   np.empty((3, registers)), np.empty((3, registers)))
     return vlo, vhi, glo, ghi, valid
 
@@ -121,13 +132,14 @@ def _holds_origin(al, ah, bl, bh):
 
 @njit(**COMPILE)
 def run_gradients(code, params, creg, clo, chi, inputs, output, lo, hi, vlo, vhi, glo, ghi,
-                  valid, rl, rh, gl, gh):
+                  valid, closed, rl, rh, gl, gh):
     """Box by box, each instruction's value enclosure (its rule of
     :mod:`implicitvox.interval.rules`) and gradient enclosure (the chain rule of
     :mod:`implicitvox.interval.derivatives`, written with the same rules), over the
     rows of a :class:`~implicitvox.eval.compiled.CompiledTape`; ``valid`` is False
     where the mean value theorem fails over the box or a domain operation's
-    argument lies wholly outside its domain."""
+    argument lies wholly outside its domain (``closed``: see
+    :func:`tape_interval_gradients`)."""
     for i in range(lo.shape[1]):
         ok = True
         for k in range(creg.size):
@@ -257,9 +269,9 @@ def run_gradients(code, params, creg, clo, chi, inputs, output, lo, hi, vlo, vhi
                 for d in range(3):
                     g0, g1 = gl[d, a], gh[d, a]
                     m = numpy_maximum(-g0, g1)
-                    if al >= 0.0:
+                    if al > 0.0 or (al == 0.0 and not closed):
                         gl[d, o], gh[d, o] = g0, g1
-                    elif ah <= 0.0:
+                    elif ah < 0.0 or (ah == 0.0 and not closed):
                         gl[d, o], gh[d, o] = -g1, -g0
                     else:
                         gl[d, o], gh[d, o] = -m, m
@@ -316,7 +328,8 @@ def run_gradients(code, params, creg, clo, chi, inputs, output, lo, hi, vlo, vhi
                 _chain3(al, ah, bl, bh, cl, ch, a, b, c, o, ol, oh, gl, gh)
             else:                                   # FLOOR
                 ol, oh = i_floor(al, ah)
-                ok = ok and np.floor(al) == np.floor(ah)
+                ok = ok and np.floor(al) == np.floor(ah) and \
+                    not (closed and (np.floor(al) == al or np.floor(ah) == ah))
                 for d in range(3):
                     gl[d, o] = gh[d, o] = 0.0
             rl[o], rh[o] = ol, oh

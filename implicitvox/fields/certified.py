@@ -28,6 +28,13 @@ The field stores ``(U + L) / 2`` with the error bound ``(U - L) / 2``. Each
 bound is computed in floating point and then moved outward by a relative
 ``2**-40`` (far above the few roundings it contains).
 
+The search runs level by level over all pairs of a block of samples: the
+enclosures of each box once, however many samples share it (compiled:
+:func:`~implicitvox.eval.mean_value_kernels.tape_interval_gradients` and
+:func:`~implicitvox.eval.compiled.evaluate_boxes`; the array evaluator for a
+tape with a sweep), then each pair's bound and each sample's candidate
+(:mod:`implicitvox.fields.certified_kernels`).
+
 Examples
 --------
 >>> import numpy as np, implicitvox as iv
@@ -49,8 +56,9 @@ import numpy as np
 from ..eval.function import Function
 from ..eval.gradient import evaluate_gradients
 from ..eval.interval import evaluate_intervals
-from ..eval.mean_value import evaluate_interval_gradients
+from ..eval.mean_value import array_interval_gradients
 from ..eval.point import evaluate_points
+from ..eval.tape import Tape
 
 __all__ = ["certified_distances", "MAX_LEVELS", "MAX_PAIRS"]
 
@@ -62,81 +70,151 @@ MAX_PAIRS = 1 << 19
 _BLOCK = 4096
 _NEWTON = 8
 _MARGIN = 2.0 ** -40
+#: the 8 children of a box: per child, which axes take the upper half
+_CORNERS = np.array(list(np.ndindex(2, 2, 2)), dtype=bool)          # (8, 3)
 
 
-class _Norm:
-    """The Euclidean norm, or the max-norm weighted by ``w`` (one row per point)."""
+class _Enclosures:
+    """``f``'s enclosures at points and over boxes, and estimates for Newton steps:
+    compiled where the tape has a compiled form, else the array evaluator."""
 
-    def __init__(self, name: str):
-        self.euclidean = name == "euclidean"
+    def __init__(self, tape: Tape):
+        from ..eval import compiled, mean_value_kernels          # (load Numba)
+        from . import certified_kernels
+        self.tape = tape
+        self.kernels = certified_kernels
+        self.evaluate_boxes = compiled.evaluate_boxes
+        self.gradients = mean_value_kernels.tape_interval_gradients
+        self.compiled = None if tape.undefined else compiled.compiled_tape(tape)
 
-    def length(self, v: np.ndarray, w: np.ndarray) -> np.ndarray:
-        if self.euclidean:
-            return np.sqrt(np.einsum("ij,ij->i", v, v))
-        return np.max(np.abs(v) / w, axis=1)
+    def boxes(self, lo: np.ndarray, hi: np.ndarray) -> tuple:
+        """``(vlo, vhi, glo, ghi, valid)`` over boxes ``lo, hi`` (3, m): values (m,),
+        gradients (3, m), where the mean value theorem holds (m,)."""
+        m = lo.shape[1]
+        if self.compiled is not None:
+            return self.gradients(self.tape, lo, hi, libm=True, closed=True)
+        with np.errstate(all="ignore"):
+            vlo, vhi, glo, ghi, valid = array_interval_gradients(self.tape, tuple(lo), tuple(hi))
+        return (np.broadcast_to(vlo, (m,)), np.broadcast_to(vhi, (m,)),
+                np.ascontiguousarray(np.broadcast_to(glo, (3, m))),
+                np.ascontiguousarray(np.broadcast_to(ghi, (3, m))), np.broadcast_to(valid, (m,)))
 
-    def dual(self, g: np.ndarray, w: np.ndarray) -> np.ndarray:
-        """How fast ``g·q`` can change per unit of distance: the dual norm."""
-        if self.euclidean:
-            return np.sqrt(np.einsum("ij,ij->i", g, g))
-        return np.sum(np.abs(g) * w, axis=1)
+    def at(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Enclosures ``(lo, hi)`` of ``f`` at the points ``q`` (3, n), rounded
+        outward (empty, ``lo > hi``, outside the domain)."""
+        n = q.shape[1]
+        if self.compiled is not None:
+            return self.evaluate_boxes(self.compiled, q, q)
+        with np.errstate(all="ignore"):
+            lo, hi = evaluate_intervals(self.tape, tuple(q), tuple(q))
+        return np.broadcast_to(lo, (n,)), np.broadcast_to(hi, (n,))
 
-    def step(self, g: np.ndarray, w: np.ndarray) -> np.ndarray:
-        """The unit vector along which ``g·q`` grows fastest."""
-        with np.errstate(invalid="ignore", divide="ignore"):
-            if self.euclidean:
-                return g / self.dual(g, w)[:, None]
-            return np.sign(g) * w
+    def estimates(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Values (n,) and gradients (n, 3) near ``f``'s and ``∇f``'s at the points
+        ``q`` (n, 3), for Newton steps (the midpoints of their enclosures; the array
+        evaluator's floats for a tape with a sweep)."""
+        n = len(q)
+        with np.errstate(all="ignore"):
+            if self.compiled is not None:
+                qt = np.ascontiguousarray(q.T)
+                vlo, vhi, glo, ghi, _ = self.gradients(self.tape, qt, qt, libm=True)
+                return 0.5 * (vlo + vhi), (0.5 * (glo + ghi)).T
+            v, g = evaluate_gradients(self.tape, *q.T)
+        return (np.broadcast_to(v, (n,)),
+                np.broadcast_to(np.asarray(g).reshape(3, -1), (3, n)).T)
 
 
-def _signs(tape, q: np.ndarray) -> np.ndarray:
+def _length(v: np.ndarray, w: np.ndarray, euclidean: bool) -> np.ndarray:
+    """The Euclidean norm of the rows of ``v``, or their max-norm weighted by ``w``."""
+    if euclidean:
+        return np.sqrt(np.einsum("ij,ij->i", v, v))
+    return np.max(np.abs(v) / w, axis=1)
+
+
+def _signs(ev: _Enclosures, q: np.ndarray) -> np.ndarray:
     """+1 / -1 where the sign of ``f(q)`` is proved (outward-rounded enclosure), else 0."""
-    cols = tuple(q.T)
+    lo, hi = ev.at(np.ascontiguousarray(q.T))
+    return np.where((lo > 0) & (lo <= hi), 1, np.where((hi < 0) & (lo <= hi), -1, 0))
+
+
+def _certified_upper(ev: _Enclosures, euclidean: bool, p: np.ndarray, w: np.ndarray,
+                     q: np.ndarray, direction: np.ndarray, delta: np.ndarray) -> np.ndarray:
+    """Upper bounds from short segments through ``q`` whose ends have proved opposite
+    signs (``inf`` where none): ``q ± delta·direction`` (across the surface where
+    ``direction`` is its normal), and ``q ± delta·(q - p) / |q - p|``, along the ray
+    from the point (across it where ``q`` is near the nearest zero, also at a kink of
+    the surface, where the gradient at ``q`` is one side's)."""
     with np.errstate(all="ignore"):
-        lo, hi = evaluate_intervals(tape, cols, cols)
-    lo = np.broadcast_to(lo, (len(q),))
-    hi = np.broadcast_to(hi, (len(q),))
-    return np.where(lo > 0, 1, np.where(hi < 0, -1, 0))
+        ray = (q - p) / np.linalg.norm(q - p, axis=1, keepdims=True)
+    best = np.full(len(p), np.inf)
+    for u in (direction, ray):
+        a = q - delta[:, None] * u
+        b = q + delta[:, None] * u
+        finite = np.all(np.isfinite(a), axis=1) & np.all(np.isfinite(b), axis=1)
+        a, b = np.where(finite[:, None], a, 0.0), np.where(finite[:, None], b, 0.0)
+        ok = (_signs(ev, a) * _signs(ev, b) < 0) & finite
+        far = np.maximum(_length(a - p, w, euclidean), _length(b - p, w, euclidean))
+        best = np.minimum(best, np.where(ok, far * (1 + _MARGIN), np.inf))
+    return best
 
 
-def _certified_upper(tape, norm: _Norm, p: np.ndarray, w: np.ndarray, q: np.ndarray,
-                     direction: np.ndarray, delta: np.ndarray) -> np.ndarray:
-    """Upper bounds from segments ``q ± delta·direction`` whose ends have proved
-    opposite signs (``inf`` elsewhere)."""
-    a = q - delta[:, None] * direction
-    b = q + delta[:, None] * direction
-    sa, sb = _signs(tape, a), _signs(tape, b)
-    ok = (sa * sb < 0) & np.all(np.isfinite(a), axis=1) & np.all(np.isfinite(b), axis=1)
-    far = np.maximum(norm.length(a - p, w), norm.length(b - p, w))
-    return np.where(ok, far * (1 + _MARGIN), np.inf)
+def _ray_upper(ev: _Enclosures, euclidean: bool, p: np.ndarray, w: np.ndarray, q: np.ndarray,
+               span: np.ndarray, steps: int = 16) -> np.ndarray:
+    """Upper bounds from a sign change on the ray from ``p`` through ``q``: where
+    ``f``'s signs are proved opposite at distances ``|q - p| ∓ span`` along it, the
+    segment is halved ``steps`` times, keeping ends of proved opposite signs, and
+    its far end bounds the distance (``inf`` where the ends' signs are not
+    opposite). Newton steps stall near a kink of the surface (an edge, a corner),
+    where a short segment through their last point may not cross it; this finds
+    the crossing anyway."""
+    with np.errstate(all="ignore"):
+        t = np.linalg.norm(q - p, axis=1)
+        ray = (q - p) / t[:, None]
+    ok = np.isfinite(t) & np.all(np.isfinite(ray), axis=1) & np.isfinite(span) & (t > 0)
+    ray = np.where(ok[:, None], ray, 0.0)
+    ta, tb = np.where(ok, np.maximum(t - span, 0.0), 0.0), np.where(ok, t + span, 0.0)
+    sa = _signs(ev, p + ta[:, None] * ray)
+    sb = _signs(ev, p + tb[:, None] * ray)
+    ok &= sa * sb < 0
+    live = ok.copy()
+    for _ in range(steps):
+        tm = 0.5 * (ta + tb)
+        sm = _signs(ev, p + tm[:, None] * ray)
+        live &= sm != 0
+        ta = np.where(live & (sm == sa), tm, ta)
+        tb = np.where(live & (sm == sb), tm, tb)
+    far = _length(ray, w, euclidean) * tb
+    return np.where(ok, far * (1 + _MARGIN) + _MARGIN * (1.0 + np.max(np.abs(p), axis=1)),
+                    np.inf)
 
 
-def _newton(tape, q: np.ndarray, steps: int) -> np.ndarray:
+def _newton(ev: _Enclosures, q: np.ndarray, steps: int) -> np.ndarray:
     """Newton steps ``q <- q - f(q) ∇f / |∇f|²`` towards the surface (lanes where a
     step is not finite stay)."""
     with np.errstate(all="ignore"):
         for _ in range(steps):
-            v, g = evaluate_gradients(tape, *q.T)
-            v = np.broadcast_to(v, (len(q),))
-            g = np.broadcast_to(np.asarray(g).reshape(3, -1), (3, len(q))).T
+            v, g = ev.estimates(q)
             gg = np.einsum("ij,ij->i", g, g)
             move = np.where((gg > 0)[:, None], -(v / np.where(gg > 0, gg, 1))[:, None] * g, 0.0)
             q = np.where(np.all(np.isfinite(move), axis=1)[:, None], q + move, q)
     return q
 
 
-def _newton_upper(tape, norm: _Norm, p: np.ndarray, w: np.ndarray, scale: float) -> np.ndarray:
+def _newton_upper(ev: _Enclosures, euclidean: bool, p: np.ndarray, w: np.ndarray,
+                  scale: float) -> np.ndarray:
     """Upper bounds from Newton projections ``q <- q - f(q) ∇f / |∇f|²`` of the points."""
-    q = _newton(tape, p, _NEWTON)
+    q = _newton(ev, p, _NEWTON)
     with np.errstate(all="ignore"):
-        _, g = evaluate_gradients(tape, *q.T)
-        g = np.broadcast_to(np.asarray(g).reshape(3, -1), (3, len(q))).T
+        _, g = ev.estimates(q)
         unit = g / np.linalg.norm(g, axis=1, keepdims=True)
     unit = np.where(np.all(np.isfinite(unit), axis=1)[:, None], unit, 0.0)
     best = np.full(len(p), np.inf)
     for rel in (1e-9, 1e-6, 1e-3):
-        best = np.minimum(best, _certified_upper(tape, norm, p, w, q, unit,
+        best = np.minimum(best, _certified_upper(ev, euclidean, p, w, q, unit,
                                                  np.full(len(p), rel * scale)))
+    stalled = ~np.isfinite(best)
+    best[stalled] = _ray_upper(ev, euclidean, p[stalled], w[stalled], q[stalled],
+                               np.full(int(stalled.sum()), scale))
     return best
 
 
@@ -176,16 +254,16 @@ def certified_distances(func: Function, points: np.ndarray, norm: str, weights: 
         held in the boxes.
     """
     from scipy.spatial import cKDTree
-    nm = _Norm(norm)
+    euclidean = norm == "euclidean"
     p = np.asarray(points, dtype=np.float64)
     n = len(p)
-    w = np.ones((n, 3)) if weights is None or nm.euclidean else \
+    w = np.ones((n, 3)) if weights is None or euclidean else \
         np.broadcast_to(np.asarray(weights, dtype=np.float64), (n, 3))
     value = np.zeros(n)
     error = np.zeros(n)
     if n == 0:
         return value, error
-    tape = func.tape
+    ev = _Enclosures(func.tape)
     boxes_lo = np.asarray(boxes_lo, dtype=np.float64)
     boxes_hi = np.asarray(boxes_hi, dtype=np.float64)
     half_diag = float(np.max(np.linalg.norm(boxes_hi - boxes_lo, axis=1))) / 2 if len(boxes_lo) \
@@ -194,8 +272,8 @@ def certified_distances(func: Function, points: np.ndarray, norm: str, weights: 
     scale = float(np.max(boxes_hi - boxes_lo)) if len(boxes_lo) else 1.0
     span = np.concatenate([boxes_hi, p]).max(axis=0) - np.concatenate([boxes_lo, p]).min(axis=0) \
         if len(boxes_lo) else np.zeros(3)
-    max_reach = max(limit, float(np.max(span / (1.0 if nm.euclidean else np.min(w)))) * 2.0)
-    sign = _point_signs(tape, p)
+    max_reach = max(limit, float(np.max(span / (1.0 if euclidean else np.min(w)))) * 2.0)
+    sign = _point_signs(ev, p)
     stats = {} if stats is None else stats
     stats.setdefault("pairs", 0)
     stats.setdefault("capped", 0)
@@ -203,7 +281,7 @@ def certified_distances(func: Function, points: np.ndarray, norm: str, weights: 
         rows = np.arange(s, min(s + _BLOCK, n))
         reach = limit
         while len(rows):
-            lo_b, up_b = _bracket(tape, nm, p[rows], w[rows], tree, boxes_lo, boxes_hi,
+            lo_b, up_b = _bracket(ev, euclidean, p[rows], w[rows], tree, boxes_lo, boxes_hi,
                                   half_diag, scale, reach, tolerance, max_levels, stats)
             value[rows] = 0.5 * (lo_b + up_b)
             error[rows] = 0.5 * (up_b - lo_b)
@@ -218,233 +296,127 @@ def certified_distances(func: Function, points: np.ndarray, norm: str, weights: 
     return sign * value, error
 
 
-def _point_signs(tape, p: np.ndarray) -> np.ndarray:
+def _point_signs(ev: _Enclosures, p: np.ndarray) -> np.ndarray:
     """Signs of ``f`` at the points: proved where the enclosure excludes 0; where it
     does not, the point is within rounding of the surface and the float value's
     sign is taken (the distance there is 0 within the error)."""
-    proved = _signs(tape, p)
+    proved = _signs(ev, p)
     with np.errstate(all="ignore"):
-        v = np.broadcast_to(evaluate_points(tape, *p.T), (len(p),))
+        v = np.broadcast_to(evaluate_points(ev.tape, *p.T), (len(p),))
     return np.where(proved != 0, proved, np.where(v < 0, -1.0, 1.0)).astype(np.float64)
 
 
-def _bracket(tape, nm: _Norm, p, w, tree, boxes_lo, boxes_hi, half_diag, scale, limit,
+def _bracket(ev, euclidean, p, w, tree, boxes_lo, boxes_hi, half_diag, scale, limit,
              tolerance, max_levels, stats):
     """``(L, U)`` for one block of points (see the module docstring)."""
     n = len(p)
     if tree is None:                    # no box may hold the surface: none within reach
         return np.full(n, limit), np.full(n, np.inf)
-    upper = _newton_upper(tape, nm, p, w, scale)
+    upper = _newton_upper(ev, euclidean, p, w, scale)
     # the initial pairs: boxes whose centre is within reach (a superset, then exact),
     # gathered for groups of points with at most MAX_PAIRS pairs between them
     reach = np.minimum(upper, limit)
-    euclid_reach = reach * (1.0 if nm.euclidean else np.sqrt(3) * float(np.max(w))) + half_diag
+    euclid_reach = reach * (1.0 if euclidean else np.sqrt(3) * float(np.max(w))) + half_diag
     counts = np.asarray(tree.query_ball_point(p, euclid_reach, return_length=True),
                         dtype=np.int64)
     lower = np.where(counts == 0, reach, 0.0)     # no box within reach: nothing nearer
-    state = {"upper": upper, "lower": lower, "open": counts > 0}
+    state = {"upper": upper, "lower": lower, "open": counts > 0,
+             # the domain the boxes cover (their bounding box): a nearest zero inside it
+             # meets the Fritz John condition (certified_kernels.pair_bounds)
+             "interior_lo": boxes_lo.min(axis=0), "interior_hi": boxes_hi.max(axis=0)}
     group = np.cumsum(counts) // MAX_PAIRS
     for g in np.unique(group[counts > 0]):
         rows = np.flatnonzero((group == g) & (counts > 0))
         found = tree.query_ball_point(p[rows], euclid_reach[rows])
         box = np.fromiter(itertools.chain.from_iterable(found), dtype=np.int64,
                           count=int(counts[rows].sum()))
+        used, box = np.unique(box, return_inverse=True)
         pt = np.repeat(rows, counts[rows])
-        _refine(tape, nm, p, w, pt, boxes_lo[box], boxes_hi[box], box, 0, state, limit,
-                tolerance, max_levels, stats)
+        _refine(ev, euclidean, p, w, pt, box.reshape(-1), np.ascontiguousarray(boxes_lo[used].T),
+                np.ascontiguousarray(boxes_hi[used].T), 0, state, limit, tolerance, max_levels,
+                stats)
     lower, upper = state["lower"], state["upper"]
     # outward: a relative margin, and one for the roundings of coordinates of this size
     slack = _MARGIN * (1.0 + float(np.max(np.abs(p))))
     return np.maximum(lower * (1 - _MARGIN) - slack, 0.0), upper
 
 
-def _refine(tape, nm, p, w, pt, lo, hi, bid, level, state, limit, tolerance, max_levels,
+def _refine(ev, euclidean, p, w, pt, box, lo, hi, level, state, limit, tolerance, max_levels,
             stats):
-    """Bound, prune and split the pairs ``(pt, box)`` level by level (``bid`` names each
-    box: its surface voxel, then ``8 * parent + child``); where the children
-    would exceed :data:`MAX_PAIRS`, the points are halved and each half refined on its
-    own (a point's pairs stay together, so its bounds come from all of them)."""
+    """Bound, prune and split the pairs ``(pt, box)`` level by level (``pt`` sorted;
+    ``box`` indexes the boxes ``lo, hi`` (3, m) of this level, each evaluated once);
+    where the children would exceed :data:`MAX_PAIRS`, the points are halved and each
+    half refined on its own (a point's pairs stay together, so its bounds come from
+    all of them)."""
     upper, lower, open_ = state["upper"], state["lower"], state["open"]
+    n = len(p)
     while len(pt):
-        mine = np.unique(pt)
-        lb, cand_pt, cand = _pair_bounds(tape, nm, p, w, pt, lo, hi, bid)
-        np.minimum.at(upper, cand_pt, cand)
+        keep = np.empty(len(pt), dtype=bool)
+        ev.kernels.shell_pairs(euclidean, p, w, pt, lo, hi, box, lower, np.minimum(upper, limit),
+                               keep)
+        pt, box, lo, hi = _kept_boxes(pt[keep], box[keep], lo, hi)
+        if not len(pt):
+            return
+        mine = pt[np.r_[True, pt[1:] != pt[:-1]]]
+        vlo, vhi, glo, ghi, valid = ev.boxes(lo, hi)
+        clo, chi = ev.at(0.5 * (lo + hi))
+        lb = np.empty(len(pt))
+        lead = np.full(n, -1, dtype=np.int64)
+        lead_q, lead_unit, lead_delta = np.empty((n, 3)), np.empty((n, 3)), np.empty(n)
+        ev.kernels.pair_bounds(euclidean, p, w, pt, box, lo, hi, vlo, vhi, glo, ghi, valid, clo,
+                               chi, state["interior_lo"], state["interior_hi"], lb, lead, lead_q,
+                               lead_unit, lead_delta)
+        # a candidate zero for each point, from its box of least bound: the point's
+        # nearest point on the slab's middle plane, clipped to the box, then two
+        # Newton steps, certified by a short segment across the surface
+        r = np.flatnonzero(lead >= 0)
+        q = _newton(ev, lead_q[r], steps=2)
+        cand = _certified_upper(ev, euclidean, p[r], w[r], q, lead_unit[r], lead_delta[r])
+        stalled = ~np.isfinite(cand)
+        cand[stalled] = _ray_upper(ev, euclidean, p[r[stalled]], w[r[stalled]], q[stalled],
+                                   1e4 * lead_delta[r[stalled]])
+        upper[r] = np.minimum(upper[r], cand)
         reach = np.minimum(upper, limit)
-        keep = np.isfinite(lb) & (lb <= reach[pt])
-        pt, lo, hi, lb, bid = pt[keep], lo[keep], hi[keep], lb[keep], bid[keep]
-        best = np.full(len(p), np.inf)
-        np.minimum.at(best, pt, lb)
+        best = np.full(n, np.inf)
+        keep = np.empty(len(pt), dtype=bool)
+        ev.kernels.settle_pairs(pt, lb, reach, best, keep)
+        pt, box = pt[keep], box[keep]
         lower[mine] = np.where(open_[mine], np.minimum(best[mine], reach[mine]), lower[mine])
         open_[mine] &= reach[mine] - lower[mine] > tolerance
         still = open_[pt]
-        pt, lo, hi, bid = pt[still], lo[still], hi[still], bid[still]
+        pt, box = pt[still], box[still]
         if level == max_levels or not len(pt):
             return
-        pt, lo, hi, bid = _split(pt, lo, hi, bid)
+        pt, box, lo, hi = _split(pt, box, lo, hi)
         level += 1
         stats["pairs"] += len(pt)
         if len(pt) > MAX_PAIRS:
-            points = np.unique(pt)
+            points = pt[np.r_[True, pt[1:] != pt[:-1]]]
             if len(points) == 1:            # one point's pairs alone are too many: stop here
                 stats["capped"] += 1
                 return
             first = pt < points[len(points) // 2]
-            _refine(tape, nm, p, w, pt[first], lo[first], hi[first], bid[first], level, state,
-                    limit, tolerance, max_levels, stats)
-            _refine(tape, nm, p, w, pt[~first], lo[~first], hi[~first], bid[~first], level,
-                    state, limit, tolerance, max_levels, stats)
+            for half in (first, ~first):
+                _refine(ev, euclidean, p, w, pt[half], box[half], lo, hi, level, state, limit,
+                        tolerance, max_levels, stats)
             return
 
 
-def _split(pt, lo, hi, bid):
-    """Each box into its 8 children (the pairs' point repeated), named ``8 * bid + k``."""
-    mid = 0.5 * (lo + hi)
-    corner = np.array(list(np.ndindex(2, 2, 2)), dtype=bool)          # (8, 3)
-    clo = np.where(corner[None], mid[:, None], lo[:, None]).reshape(-1, 3)
-    chi = np.where(corner[None], hi[:, None], mid[:, None]).reshape(-1, 3)
-    children = (bid[:, None] * 8 + np.arange(8)[None]).reshape(-1)
-    return np.repeat(pt, 8), clo, chi, children
+def _kept_boxes(pt, box, lo, hi):
+    """The pairs ``(pt, box)`` on a box table holding only the boxes they name."""
+    used = np.zeros(lo.shape[1], dtype=bool)
+    used[box] = True
+    index = np.cumsum(used) - 1
+    return pt, index[box], lo[:, used], hi[:, used]
 
 
-def _pair_bounds(tape, nm: _Norm, p, w, pt, lo, hi, bid):
-    """Per (point, box) pair: a lower bound of the distance from point ``pt`` to the
-    zeros of ``f`` in the box (``inf`` if the box has none). Boxes shared by several
-    points (same ``bid``) are evaluated once. Also ``(points, upper)``: for each point,
-    an upper bound from a certified zero near the plane of its most promising box
-    (``inf`` where none was proved)."""
-    boxes, first, which = np.unique(bid, return_index=True, return_inverse=True)
-    ulo, uhi = lo[first], hi[first]
-    with np.errstate(all="ignore"):
-        vlo, vhi, glo, ghi, valid = evaluate_interval_gradients(tape, tuple(ulo.T), tuple(uhi.T))
-        uc = 0.5 * (ulo + uhi)
-        clo, chi = evaluate_intervals(tape, tuple(uc.T), tuple(uc.T))
-    k = len(boxes)
-    vlo, vhi = np.broadcast_to(vlo, (k,))[which], np.broadcast_to(vhi, (k,))[which]
-    clo, chi = np.broadcast_to(clo, (k,))[which], np.broadcast_to(chi, (k,))[which]
-    glo = np.broadcast_to(glo, (3, k)).T[which]
-    ghi = np.broadcast_to(ghi, (3, k)).T[which]
-    valid = np.broadcast_to(valid, (k,))[which]
-    c = uc[which]
-    q_pt, q_w = p[pt], w[pt]
-    has_zero = (vlo <= 0) & (vhi >= 0)
-    gap = np.maximum(np.maximum(lo - q_pt, q_pt - hi), 0.0)
-    to_box = nm.length(gap, q_w)
-    # the slab of the box's zeros (mean value form)
-    half = 0.5 * (hi - lo)
-    with np.errstate(all="ignore"):
-        g = 0.5 * (glo + ghi)
-        spread = np.sum(0.5 * (ghi - glo) * half, axis=1)
-        gc = np.einsum("ij,ij->i", g, c)
-        # widened by the roundings of these few operations (each relative 2**-53)
-        slack = 8 * np.finfo(np.float64).eps * (np.abs(gc) + np.maximum(np.abs(clo), np.abs(chi))
-                                                + spread)
-        s_lo = gc - chi - spread - slack
-        s_hi = gc - clo + spread + slack
-        gp = np.einsum("ij,ij->i", g, q_pt)
-        dual = nm.dual(g, q_w)
-        to_slab = np.maximum(np.maximum(s_lo - gp, gp - s_hi), 0.0) / dual
-        if nm.euclidean:
-            to_both = _euclidean_box_slab(q_pt, lo, hi, g, s_lo, s_hi)
-        else:
-            to_both = _linf_box_slab(q_pt, q_w, lo, hi, g, s_lo, s_hi)
-    slab_ok = valid & (dual > 0) & np.isfinite(to_slab) & (clo <= chi) & ~np.isnan(to_both)
-    lb = np.where(slab_ok, np.maximum(to_box, to_both), to_box)
-    lb = np.where(has_zero, lb, np.inf)
-    # a candidate zero for each point, from its box of least bound: the point's nearest
-    # point on the slab's middle plane, clipped to the box, then two Newton steps
-    order = np.lexsort((lb, pt))
-    lead = order[np.r_[True, pt[order][1:] != pt[order][:-1]]] if len(order) else order
-    lead = lead[has_zero[lead] & slab_ok[lead]]
-    r = lead
-    direction = nm.step(g[r], q_w[r])
-    with np.errstate(all="ignore"):
-        q = q_pt[r] + (((s_lo[r] + s_hi[r]) / 2 - gp[r]) / dual[r])[:, None] * direction
-    q = _newton(tape, np.clip(np.where(np.isfinite(q), q, c[r]), lo[r], hi[r]), steps=2)
-    with np.errstate(all="ignore"):
-        unit = g[r] / np.linalg.norm(g[r], axis=1, keepdims=True)
-    unit = np.where(np.isfinite(unit), unit, 0.0)
-    delta = np.maximum(np.max(half[r], axis=1) * 1e-4, 1e-12 * (1 + np.max(np.abs(c[r]), axis=1)))
-    upper = _certified_upper(tape, nm, q_pt[r], q_w[r], q, unit, delta)
-    return lb, pt[r], upper
-
-
-def _euclidean_box_slab(p, lo, hi, g, s_lo, s_hi):
-    """The Euclidean distance from ``p`` to box ∩ slab, exactly (``inf`` where it is
-    empty: no zero in the box). If the box's nearest point to ``p`` is in the slab it
-    is the answer; else the nearest point of box ∩ {g·q = s} (the slab's near face)
-    is ``clip(p + λ g, lo, hi)`` for the ``λ`` where ``φ(λ) = g·clip(p + λ g, lo, hi)``,
-    a non-decreasing piecewise linear function with a break where each coordinate
-    meets a face of the box, reaches ``s`` (the projection onto a box and a hyperplane,
-    as in the continuous quadratic knapsack). The breaks are sorted and ``φ`` is
-    interpolated between the two around ``s``; all pairs at once."""
-    q0 = np.clip(p, lo, hi)
-    v0 = np.einsum("ij,ij->i", g, q0)
-    above = v0 > s_hi
-    outside = (v0 < s_lo) | above
-    direction = np.where(above[:, None], -g, g)               # towards the slab
-    target = np.where(above, -s_hi, s_lo)
-    moving = direction != 0
-    with np.errstate(divide="ignore", invalid="ignore"):
-        breaks = np.concatenate([np.where(moving, (lo - p) / direction, np.inf),
-                                 np.where(moving, (hi - p) / direction, np.inf)], axis=1)
-    breaks = np.where(breaks > 0, breaks, np.inf)
-    breaks = np.sort(np.concatenate([np.zeros((len(p), 1)), breaks], axis=1), axis=1)
-    finite = np.isfinite(breaks)
-    lam = np.where(finite, breaks, 0.0)                        # (m, 7)
-    moved = np.clip(p[:, None] + lam[..., None] * direction[:, None], lo[:, None], hi[:, None])
-    phi = np.where(finite, np.einsum("mkj,mj->mk", moved, direction), -np.inf)
-    reached = phi >= target[:, None]
-    first = np.argmax(reached, axis=1)
-    found = reached.any(axis=1)
-    before = np.maximum(first - 1, 0)[:, None]
-    after = first[:, None]
-    l0, l1 = np.take_along_axis(lam, before, 1)[:, 0], np.take_along_axis(lam, after, 1)[:, 0]
-    f0, f1 = np.take_along_axis(phi, before, 1)[:, 0], np.take_along_axis(phi, after, 1)[:, 0]
-    with np.errstate(divide="ignore", invalid="ignore"):
-        step = np.where(f1 > f0, l0 + (target - f0) / (f1 - f0) * (l1 - l0), l1)
-    step = np.where(found, step, 0.0)
-    q = np.clip(p + step[:, None] * direction, lo, hi)
-    d = np.where(outside, np.linalg.norm(q - p, axis=1), np.linalg.norm(q0 - p, axis=1))
-    return np.where(outside & ~found, np.inf, d)
-
-
-def _first_reach(start: np.ndarray, slope: np.ndarray, stop: np.ndarray, target: np.ndarray
-                 ) -> np.ndarray:
-    """The least ``t >= 0`` with ``start + sum_i slope_i min(t, stop_i) >= target`` (a
-    concave, non-decreasing piecewise linear function; ``inf`` if never)."""
-    order = np.argsort(stop, axis=1)
-    tau = np.take_along_axis(stop, order, axis=1)
-    k = np.take_along_axis(slope, order, axis=1)
-    out = np.full(len(start), np.inf)
-    base = start + np.sum(k * np.minimum(0.0, tau), axis=1)      # the value at t = 0
-    out = np.where(base >= target, 0.0, out)
-    left = np.zeros(len(start))
-    value = base
-    for j in range(4):                                            # segments between breaks
-        right = tau[:, j] if j < 3 else np.full(len(start), np.inf)
-        right = np.maximum(right, left)
-        rate = np.sum(np.where(tau >= right[:, None], k, 0.0), axis=1) if j < 3 else \
-            np.sum(np.where(np.isinf(tau), k, 0.0), axis=1)
-        with np.errstate(invalid="ignore", divide="ignore"):
-            t = left + (target - value) / rate
-        hit = np.isinf(out) & (rate > 0) & (t >= left) & (t <= right)
-        out = np.where(hit, t, out)
-        with np.errstate(invalid="ignore"):
-            value = np.where(np.isfinite(right), value + rate * (right - left), value)
-        left = right
-    return out
-
-
-def _linf_box_slab(p, w, lo, hi, g, s_lo, s_hi):
-    """The weighted max-norm distance from ``p`` to (box ∩ slab), exactly: the cube
-    ``C(p, t)`` meets it iff ``C(p, t) ∩ box`` (a box, non-empty from ``t = to_box``)
-    reaches the slab, and the largest and smallest ``g·q`` over that box are concave
-    and convex piecewise linear in ``t``, with a break per axis where the cube passes
-    the box's face."""
-    a = np.abs(g) * w
-    up_stop = np.where(g >= 0, hi - p, p - lo) / w                 # where g·q stops rising
-    down_stop = np.where(g >= 0, p - lo, hi - p) / w               # ... stops falling
-    gp = np.einsum("ij,ij->i", g, p)
-    t_up = _first_reach(gp, a, up_stop, s_lo)
-    t_down = _first_reach(-gp, a, down_stop, -s_hi)
-    return np.maximum(t_up, t_down)
+def _split(pt, box, lo, hi):
+    """Each box that still has pairs into its 8 children (box ``k`` of those kept
+    becomes boxes ``8k .. 8k + 7``), each pair into 8."""
+    pt, box, ulo, uhi = _kept_boxes(pt, box, lo, hi)
+    mid = 0.5 * (ulo + uhi)
+    upper_half = _CORNERS.T[:, None, :]                                 # (3, 1, 8)
+    clo = np.where(upper_half, mid[:, :, None], ulo[:, :, None]).reshape(3, -1)
+    chi = np.where(upper_half, uhi[:, :, None], mid[:, :, None]).reshape(3, -1)
+    children = (box[:, None] * 8 + np.arange(8)[None]).reshape(-1)
+    return np.repeat(pt, 8), children, clo, chi

@@ -152,6 +152,43 @@ def test_certified_distances_of_an_expression_hold_the_truth_within_1e3_voxel(no
     assert field.max_error <= 1e-3 * field.grid.voxel_size[0]
 
 
+def test_certified_distances_to_a_kinked_surface_keep_its_edges_and_corners():
+    # f = max(|x|, |y|, |z|)^2 - 1/4 is a cube with kinks on its edges and faces'
+    # diagonals; outside points' nearest points lie on edges and corners, where only
+    # Clarke's generalized gradient is parallel to p - q: the search may not prune
+    # those boxes (certified_kernels.pair_bounds), nor the ones on the domain's faces
+    m = iv.max(iv.max(iv.abs(x), iv.abs(y)), iv.abs(z))
+    field = iv.distance_field(m * m - 0.25, 16, band=2, bounds=((-0.8,) * 3, (0.8,) * 3),
+                              check_suitability=False)
+    p, v, e = _band(field)
+    a = np.abs(p) - 0.5
+    truth = np.where(np.max(a, axis=1) > 0, np.linalg.norm(np.maximum(a, 0), axis=1),
+                     np.max(a, axis=1))
+    assert field.kind == "certified"
+    assert np.all(np.abs(v - truth) <= e * (1 + 1e-9) + 1e-15)
+    corner = np.all(a > 0, axis=1)
+    assert corner.sum() > 20 and field.max_error <= 1e-3 * field.grid.voxel_size[0]
+
+
+def test_certified_distances_to_a_ridge_on_the_voxels_faces():
+    # z = 0.3 - |x|: a roof whose ridge lies on voxel faces (x = 0), nearest to the
+    # samples above it; the boxes on either side see one face's gradient over their
+    # open part, so the search must take the gradients on the closed box (both sides'
+    # hull) to keep them (mean_value_kernels.tape_interval_gradients(closed=True))
+    field = iv.distance_field(z + iv.abs(x) - 0.3, 16, band=2,
+                              bounds=((-0.8,) * 3, (0.8,) * 3), check_suitability=False)
+    p, v, e = _band(field)
+    ax, pz = np.abs(p[:, 0]), p[:, 2]
+    t = (ax + pz - 0.3) / 2                                   # the foot on the nearer face
+    on_face = ax - t >= 0
+    truth = np.sign(ax + pz - 0.3) * np.where(on_face, np.abs(ax + pz - 0.3) / np.sqrt(2),
+                                              np.hypot(ax, pz - 0.3))
+    inside = np.where(on_face, ax - t, 0.0) < 0.7             # nearest point in the domain
+    assert field.kind == "certified" and (~on_face).sum() > 50
+    assert np.all((np.abs(v - truth) <= e * (1 + 1e-9) + 1e-15)[inside])
+    assert field.max_error <= 1e-3 * field.grid.voxel_size[0]
+
+
 def test_certified_torus_as_a_product_of_quadrics():
     R, r = 0.6, 0.25
     q = x * x + y * y + z * z + R * R - r * r
@@ -296,7 +333,8 @@ def test_a_field_everywhere_holds_every_sample():
 def test_box_slab_lower_bounds_never_exceed_the_distance_to_box_and_slab():
     # the bounds the certified search prunes with, against dense samples of box ∩ slab,
     # including points on the slab's normal through the box (a direction of rounding)
-    from implicitvox.fields.certified import _euclidean_box_slab, _linf_box_slab
+    from implicitvox.fields.certified_kernels import euclidean_box_slab, linf_box_slab
+    room = np.empty(9)
     rng = np.random.default_rng(3)
     for trial in range(300):
         lo = rng.uniform(-1, 0, (1, 3))
@@ -313,7 +351,7 @@ def test_box_slab_lower_bounds_never_exceed_the_distance_to_box_and_slab():
         q = q[(q @ g[0] >= s_lo[0]) & (q @ g[0] <= s_hi[0])]
         if not len(q):
             continue
-        euclid = _euclidean_box_slab(p, lo, hi, g, s_lo, s_hi)[0]
+        euclid = euclidean_box_slab(p[0], lo[0], hi[0], g[0], s_lo[0], s_hi[0], room)
         assert euclid <= np.linalg.norm(q - p, axis=1).min() + 1e-12
         if trial < 20:      # and exact: a quadratic programme's optimum, found by scipy
             from scipy.optimize import Bounds, LinearConstraint, minimize
@@ -323,7 +361,7 @@ def test_box_slab_lower_bounds_never_exceed_the_distance_to_box_and_slab():
                             constraints=[LinearConstraint(g, s_lo, s_hi)],
                             options={"ftol": 1e-14, "maxiter": 500})
             assert abs(euclid - np.sqrt(best.fun)) <= 1e-5
-        cheb = _linf_box_slab(p, np.ones((1, 3)), lo, hi, g, s_lo, s_hi)[0]
+        cheb = linf_box_slab(p[0], np.ones(3), lo[0], hi[0], g[0], s_lo[0], s_hi[0], room)
         assert cheb <= np.abs(q - p).max(axis=1).min() + 1e-12
 
 

@@ -1,0 +1,333 @@
+"""The per-pair arithmetic of the certified distance search, in compiled code.
+
+:mod:`implicitvox.fields.certified` brackets the distance from each sample to
+the zeros of ``f`` by branch and bound over (sample, box) pairs, millions of
+them on a band at 128³. For each pair it needs a lower bound of the distance
+from the sample to the box's zeros, and for each sample a candidate zero near
+the plane of its most promising box. :func:`pair_bounds` computes both, pair by
+pair, from the boxes' enclosures (value, gradient, centre value); the distances
+from a point to a box cut by a slab are exact in both norms:
+
+* Euclidean (:func:`euclidean_box_slab`): the projection onto a box and a
+  hyperplane, as in the continuous quadratic knapsack;
+* weighted max-norm (:func:`linf_box_slab`): the smallest cube about the point
+  whose intersection with the box reaches the slab, from the first zeros of
+  two concave piecewise linear functions (:func:`first_reach`).
+
+Examples
+--------
+>>> import numpy as np
+>>> p, lo, hi = np.zeros(3), np.array([1.0, -1.0, -1.0]), np.array([2.0, 1.0, 1.0])
+>>> g = np.array([1.0, 0.0, 0.0])                  # the slab 1.5 <= x <= 1.75
+>>> room = np.empty(9)
+>>> float(euclidean_box_slab(p, lo, hi, g, 1.5, 1.75, room))
+1.5
+>>> float(linf_box_slab(p, np.ones(3), lo, hi, g, 1.5, 1.75, room))
+1.5
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+from ..interval.rules import COMPILE, i_addc, i_mul, i_sub
+
+__all__ = ["pair_bounds", "settle_pairs", "euclidean_box_slab", "linf_box_slab", "first_reach"]
+
+_EPS = float(np.finfo(np.float64).eps)
+_INF = math.inf
+
+
+@njit(**COMPILE)
+def _clip(v, lo, hi):
+    return lo if v < lo else (hi if v > hi else v)
+
+
+@njit(**COMPILE)
+def euclidean_box_slab(p, lo, hi, g, s_lo, s_hi, lam):
+    """The Euclidean distance from ``p`` to box ∩ slab ``{s_lo <= g·q <= s_hi}``,
+    exactly (``inf`` where it is empty). If the box's nearest point to ``p`` is in
+    the slab it is the answer; else the nearest point of box ∩ {g·q = s} (the
+    slab's near face) is ``clip(p + λ g, lo, hi)`` for the ``λ`` where
+    ``φ(λ) = g·clip(p + λ g, lo, hi)``, non-decreasing and piecewise linear with a
+    break where each coordinate meets a face of the box, reaches ``s``: the breaks
+    are sorted and ``φ`` is interpolated between the two around ``s`` (``lam``: room
+    for 7 floats)."""
+    v0 = 0.0
+    d0 = 0.0
+    for j in range(3):
+        q = _clip(p[j], lo[j], hi[j])
+        v0 += g[j] * q
+        d0 += (q - p[j]) * (q - p[j])
+    above = v0 > s_hi
+    if not (v0 < s_lo or above):
+        return math.sqrt(d0)
+    sign = -1.0 if above else 1.0                  # the direction: towards the slab
+    target = -s_hi if above else s_lo
+    lam[0] = 0.0
+    count = 1
+    for j in range(3):
+        dj = sign * g[j]
+        if dj != 0.0:
+            for face in (lo[j], hi[j]):
+                t = (face - p[j]) / dj
+                if t > 0.0 and t < _INF:
+                    lam[count] = t
+                    count += 1
+    for i in range(1, count):                      # insertion sort: at most 7
+        v = lam[i]
+        m = i - 1
+        while m >= 0 and lam[m] > v:
+            lam[m + 1] = lam[m]
+            m -= 1
+        lam[m + 1] = v
+    f_prev, l_prev = -_INF, 0.0
+    for k in range(count):
+        phi = 0.0
+        for j in range(3):
+            dj = sign * g[j]
+            phi += _clip(p[j] + lam[k] * dj, lo[j], hi[j]) * dj
+        if phi >= target:
+            l1, f1 = lam[k], phi
+            if k == 0:
+                step = l1
+            else:
+                step = l_prev + (target - f_prev) / (f1 - f_prev) * (l1 - l_prev) \
+                    if f1 > f_prev else l1
+            d = 0.0
+            for j in range(3):
+                q = _clip(p[j] + step * sign * g[j], lo[j], hi[j])
+                d += (q - p[j]) * (q - p[j])
+            return math.sqrt(d)
+        f_prev, l_prev = phi, lam[k]
+    return _INF
+
+
+@njit(**COMPILE)
+def first_reach(start, slope, stop, target):
+    """The least ``t >= 0`` with ``start + Σ_i slope_i min(t, stop_i) >= target``
+    (a concave, non-decreasing piecewise linear function; ``inf`` if never);
+    ``slope``, ``stop``: 3 values each."""
+    o0, o1, o2 = 0, 1, 2                          # the stops' order
+    if stop[o1] < stop[o0]:
+        o0, o1 = o1, o0
+    if stop[o2] < stop[o1]:
+        o1, o2 = o2, o1
+        if stop[o1] < stop[o0]:
+            o0, o1 = o1, o0
+    value = start
+    for i in range(3):
+        value += slope[i] * min(0.0, stop[i])
+    if value >= target:
+        return 0.0
+    left = 0.0
+    for j in range(4):
+        if j < 3:
+            right = stop[o0] if j == 0 else (stop[o1] if j == 1 else stop[o2])
+        else:
+            right = _INF
+        right = max(right, left)
+        rate = 0.0
+        for i in range(3):
+            if (stop[i] >= right) if j < 3 else (stop[i] == _INF):
+                rate += slope[i]
+        t = left + (target - value) / rate
+        if rate > 0.0 and t >= left and t <= right:
+            return t
+        if right < _INF:
+            value += rate * (right - left)
+        left = right
+    return _INF
+
+
+@njit(**COMPILE)
+def linf_box_slab(p, w, lo, hi, g, s_lo, s_hi, scratch):
+    """The weighted max-norm distance from ``p`` to box ∩ slab, exactly: the cube
+    ``C(p, t)`` meets it iff ``C(p, t) ∩ box`` (a box, non-empty from ``t`` = the
+    distance to the box) reaches the slab, and the largest and smallest ``g·q``
+    over that box are concave and convex piecewise linear in ``t``, with a break
+    per axis where the cube passes the box's face (``scratch``: room for 9
+    floats)."""
+    a, up_stop, down_stop = scratch[0:3], scratch[3:6], scratch[6:9]
+    gp = 0.0
+    for j in range(3):
+        a[j] = abs(g[j]) * w[j]
+        if g[j] >= 0.0:
+            up_stop[j] = (hi[j] - p[j]) / w[j]
+            down_stop[j] = (p[j] - lo[j]) / w[j]
+        else:
+            up_stop[j] = (p[j] - lo[j]) / w[j]
+            down_stop[j] = (hi[j] - p[j]) / w[j]
+        gp += g[j] * p[j]
+    return max(first_reach(gp, a, up_stop, s_lo), first_reach(-gp, a, down_stop, -s_hi))
+
+
+@njit(**COMPILE)
+def _inside(lo, hi, b, interior_lo, interior_hi):
+    for j in range(3):
+        if not (lo[j, b] > interior_lo[j] and hi[j, b] < interior_hi[j]):
+            return False
+    return True
+
+
+@njit(**COMPILE)
+def _excludes_normals(p, lo, hi, glo, ghi, b):
+    """Is ``q - p`` parallel to no ``ξ ∈ [∇f](box)`` for any ``q`` in box ``b``? (Some
+    component of the cross product ``(q - p) × ξ``, enclosed with outward rounding,
+    excludes 0.)"""
+    for j in range(3):
+        k, m = (j + 1) % 3, (j + 2) % 3
+        ukl, ukh = i_addc(lo[k, b], hi[k, b], -p[k])
+        uml, umh = i_addc(lo[m, b], hi[m, b], -p[m])
+        al, ah = i_mul(ukl, ukh, glo[m, b], ghi[m, b])
+        bl, bh = i_mul(uml, umh, glo[k, b], ghi[k, b])
+        cl, ch = i_sub(al, ah, bl, bh)
+        if cl > 0.0 or ch < 0.0:
+            return True
+    return False
+
+
+@njit(**COMPILE)
+def pair_bounds(euclidean, p, w, pt, box, lo, hi, vlo, vhi, glo, ghi, valid, clo, chi,
+                interior_lo, interior_hi, lb, lead, lead_q, lead_unit, lead_delta):
+    """Per pair ``(pt[k], box[k])``: ``lb[k]``, a lower bound of the distance from
+    sample ``p[pt[k]]`` to the zeros of ``f`` in box ``box[k]`` (``inf`` where its
+    enclosure excludes 0). The box's zeros lie in the slab of the mean value form,
+    ``g·(q - c) ∈ -[f(c)] ∓ Σ_i rad([∇f]_i) h_i`` (``g`` the gradient enclosure's
+    midpoint, ``h`` the half-sizes), widened by the roundings of these few
+    operations; the bound is the distance to box ∩ slab, or to the box where the
+    slab is not proved.
+
+    Euclidean pairs whose box lies strictly inside ``(interior_lo, interior_hi)``
+    and holds no point ``q`` where ``q - p`` is parallel to a gradient (Clarke's
+    generalized gradient where ``f`` has kinks) get ``inf`` too: the nearest zero
+    ``q*`` within the domain, if it is not on the domain's boundary, satisfies the
+    Fritz John condition ``q* - p ∥ ξ``, ``ξ ∈ ∂f(q*)``, wherever ``f`` is
+    Lipschitz (the box is valid), so such a box does not hold it; every other box's
+    bound stays, and the least of them is still a lower bound of the distance.
+
+    Per sample, ``lead[s]`` is its pair of least bound if that pair's slab holds
+    (else -1), and ``lead_q[s]`` a start for a candidate zero: the sample's nearest
+    point on the slab's middle plane, clipped to the box; ``lead_unit[s]`` the
+    unit gradient and ``lead_delta[s]`` a segment half-length for certifying it.
+    ``lead`` must hold -1 on entry; boxes' arrays are per box (``(3, m)`` for the
+    vectors), the rest per pair."""
+    best = np.full(lead.size, _INF)
+    q = np.empty(3)
+    ww = np.empty(3)
+    blo = np.empty(3)
+    bhi = np.empty(3)
+    g = np.empty(3)
+    scratch = np.empty(9)
+    slab_ok = np.zeros(pt.size, dtype=np.bool_)
+    s_mid = np.empty(pt.size)
+    for k in range(pt.size):
+        s, b = pt[k], box[k]
+        gap2 = 0.0
+        gapm = 0.0
+        gc = 0.0
+        gp = 0.0
+        spread = 0.0
+        dual2 = 0.0
+        dual1 = 0.0
+        for j in range(3):
+            q[j], ww[j] = p[s, j], w[s, j]
+            blo[j], bhi[j] = lo[j, b], hi[j, b]
+            gap = max(max(blo[j] - q[j], q[j] - bhi[j]), 0.0)
+            gap2 += gap * gap
+            gapm = max(gapm, gap / ww[j])
+            g[j] = 0.5 * (glo[j, b] + ghi[j, b])
+            spread += 0.5 * (ghi[j, b] - glo[j, b]) * (0.5 * (bhi[j] - blo[j]))
+            gc += g[j] * (0.5 * (blo[j] + bhi[j]))
+            gp += g[j] * q[j]
+            dual2 += g[j] * g[j]
+            dual1 += abs(g[j]) * ww[j]
+        if not (vlo[b] <= 0.0 and vhi[b] >= 0.0):
+            lb[k] = _INF
+            continue
+        to_box = math.sqrt(gap2) if euclidean else gapm
+        dual = math.sqrt(dual2) if euclidean else dual1
+        c_lo, c_hi = clo[b], chi[b]
+        slack = 8.0 * _EPS * (abs(gc) + max(abs(c_lo), abs(c_hi)) + spread)
+        s_lo = gc - c_hi - spread - slack
+        s_hi = gc - c_lo + spread + slack
+        to_slab = max(max(s_lo - gp, gp - s_hi), 0.0) / dual
+        if euclidean:
+            to_both = euclidean_box_slab(q, blo, bhi, g, s_lo, s_hi, scratch)
+        else:
+            to_both = linf_box_slab(q, ww, blo, bhi, g, s_lo, s_hi, scratch)
+        ok = valid[b] and dual > 0.0 and math.isfinite(to_slab) and c_lo <= c_hi \
+            and not math.isnan(to_both)
+        lb[k] = max(to_box, to_both) if ok else to_box
+        if euclidean and valid[b] and _inside(lo, hi, b, interior_lo, interior_hi) \
+                and _excludes_normals(p[s], lo, hi, glo, ghi, b):
+            lb[k] = _INF
+            continue
+        slab_ok[k] = ok
+        s_mid[k] = ((s_lo + s_hi) / 2 - gp) / dual
+        if lb[k] < best[s]:
+            best[s] = lb[k]
+            lead[s] = k
+    for s in range(lead.size):
+        k = lead[s]
+        if k < 0:
+            continue
+        if not slab_ok[k]:
+            lead[s] = -1
+            continue
+        b = box[k]
+        norm = 0.0
+        size = 0.0
+        centre = 0.0
+        for j in range(3):
+            g[j] = 0.5 * (glo[j, b] + ghi[j, b])
+            norm += g[j] * g[j]
+        norm = math.sqrt(norm)
+        for j in range(3):
+            step = g[j] / norm if euclidean else math.copysign(w[s, j], g[j]) * (g[j] != 0.0)
+            c = 0.5 * (lo[j, b] + hi[j, b])
+            v = p[s, j] + s_mid[k] * step
+            v = v if math.isfinite(v) else c
+            lead_q[s, j] = _clip(v, lo[j, b], hi[j, b])
+            u = g[j] / norm
+            lead_unit[s, j] = u if math.isfinite(u) else 0.0
+            size = max(size, 0.5 * (hi[j, b] - lo[j, b]))
+            centre = max(centre, abs(c))
+        lead_delta[s] = max(size * 1e-4, 1e-12 * (1.0 + centre))
+
+
+@njit(**COMPILE)
+def settle_pairs(pt, lb, reach, best, keep):
+    """``keep[k]``: pair ``k`` may still hold its sample's nearest zero (a finite
+    bound within the sample's reach); ``best[s]``: the least bound over the
+    sample's kept pairs (``inf`` where none; ``best`` must hold ``inf`` on
+    entry)."""
+    for k in range(pt.size):
+        s = pt[k]
+        keep[k] = math.isfinite(lb[k]) and lb[k] <= reach[s]
+        if keep[k] and lb[k] < best[s]:
+            best[s] = lb[k]
+
+
+@njit(**COMPILE)
+def shell_pairs(euclidean, p, w, pt, lo, hi, box, lower, reach, keep):
+    """``keep[k]``: box ``box[k]`` meets the shell ``lower[s] <= |q - p[s]| <= reach[s]``
+    of its sample ``s = pt[k]``, where its nearest zero lies (a box wholly nearer
+    than the proved lower bound holds no zero; one wholly past the reach need not
+    be searched)."""
+    for k in range(pt.size):
+        s, b = pt[k], box[k]
+        near2 = far2 = near = far = 0.0
+        for j in range(3):
+            dlo, dhi = lo[j, b] - p[s, j], hi[j, b] - p[s, j]
+            gap = max(max(dlo, -dhi), 0.0)
+            span = max(abs(dlo), abs(dhi))
+            near2 += gap * gap
+            far2 += span * span
+            near = max(near, gap / w[s, j])
+            far = max(far, span / w[s, j])
+        if euclidean:
+            near, far = math.sqrt(near2), math.sqrt(far2)
+        keep[k] = near <= reach[s] * (1.0 + 4.0 * _EPS) and far >= lower[s] * (1.0 - 4.0 * _EPS)
