@@ -320,7 +320,7 @@ def _bracket(ev, euclidean, p, w, tree, boxes_lo, boxes_hi, half_diag, scale, li
     counts = np.asarray(tree.query_ball_point(p, euclid_reach, return_length=True),
                         dtype=np.int64)
     lower = np.where(counts == 0, reach, 0.0)     # no box within reach: nothing nearer
-    state = {"upper": upper, "lower": lower, "open": counts > 0,
+    state = {"upper": upper, "lower": lower, "open": counts > 0, "parked": np.full(n, np.inf),
              # the domain the boxes cover (their bounding box): a nearest zero inside it
              # meets the Fritz John condition (certified_kernels.pair_bounds)
              "interior_lo": boxes_lo.min(axis=0), "interior_hi": boxes_hi.max(axis=0)}
@@ -348,7 +348,7 @@ def _refine(ev, euclidean, p, w, pt, box, lo, hi, level, state, limit, tolerance
     where the children would exceed :data:`MAX_PAIRS`, the points are halved and each
     half refined on its own (a point's pairs stay together, so its bounds come from
     all of them)."""
-    upper, lower, open_ = state["upper"], state["lower"], state["open"]
+    upper, lower, open_, parked = state["upper"], state["lower"], state["open"], state["parked"]
     n = len(p)
     while len(pt):
         keep = np.empty(len(pt), dtype=bool)
@@ -380,10 +380,15 @@ def _refine(ev, euclidean, p, w, pt, box, lo, hi, level, state, limit, tolerance
         best = np.full(n, np.inf)
         keep = np.empty(len(pt), dtype=bool)
         ev.kernels.settle_pairs(pt, lb, reach, best, keep)
-        pt, box = pt[keep], box[keep]
-        lower[mine] = np.where(open_[mine], np.minimum(best[mine], reach[mine]), lower[mine])
+        pt, box, lb = pt[keep], box[keep], lb[keep]
+        least = np.minimum(np.minimum(best[mine], parked[mine]), reach[mine])
+        lower[mine] = np.where(open_[mine], least, lower[mine])
         open_[mine] &= reach[mine] - lower[mine] > tolerance
-        still = open_[pt]
+        # a pair whose bound is within the tolerance of the reach needs no splitting:
+        # it is parked, its bound kept in the point's lower bound
+        park = lb >= reach[pt] - tolerance
+        np.minimum.at(parked, pt[park], lb[park])
+        still = open_[pt] & ~park
         pt, box = pt[still], box[still]
         if level == max_levels or not len(pt):
             return
