@@ -20,7 +20,13 @@ opening of the complement. Samples are voxel centres, so a ball's centre
 is a voxel centre (up to ``√3/2`` from the ideal one) and a voxel counts as
 covered when its centre is within ``ρ + 1`` of one: the answer is good to
 about one fine voxel (a cube, ``r = 0``, comes out below one target voxel
-at ``oversample=4``).
+at ``oversample=4``), and the bisection stops at a quarter of one.
+
+The fine grid is by default the finest of 4, 2 and 1 fine voxels per target
+voxel whose padded grid has at most :data:`SUITABILITY_FINE_CELLS` voxels (the
+time goes with them: a dozen or so distance transforms); at 256³ that is the
+target grid itself, and the answer is good to about one target voxel
+(``Suitability.oversample`` says which ran).
 
 Examples
 --------
@@ -47,13 +53,15 @@ from ..voxelizers.implicit import voxelize
 from .bounds import analytic_error_bound
 
 __all__ = ["Suitability", "suitability", "CRITICAL_RADIUS", "solid_voxels", "is_suitable_at",
-           "SUITABILITY_CHECK_LIMIT"]
+           "SUITABILITY_CHECK_LIMIT", "SUITABILITY_FINE_CELLS"]
 
 #: Condition 2: no medial surface within √6 voxels of the boundary
 CRITICAL_RADIUS = math.sqrt(6)
 #: voxels of the largest grid :func:`implicitvox.distance_field` checks the criterion on
 SUITABILITY_CHECK_LIMIT = 1 << 25
-_STEPS = 8
+#: padded fine-grid voxels :func:`suitability` takes at most by default, choosing its
+#: ``oversample`` (about a second per distance transform here)
+SUITABILITY_FINE_CELLS = 1 << 23
 
 
 @dataclass(frozen=True)
@@ -63,6 +71,7 @@ class Suitability:
     r_open: float           #: the largest ball radius for which the solid is open
     r_closed: float         #: ... and for which it is closed (``max_radius`` = no limit found)
     max_radius: float       #: the largest radius tried
+    oversample: int = 4     #: fine voxels per target voxel of the estimate (its precision)
 
     @property
     def r(self) -> float:
@@ -84,15 +93,21 @@ class Suitability:
         verdict = "suitable" if self.suitable else "not suitable"
         def shown(r: float) -> str:
             return f"{r:.2f}{'+' if r >= self.max_radius else ''}"
+        if self.r > math.sqrt(3):
+            error = f"predicted trilinear error at most {self.predicted_error:.3g} voxels"
+        else:
+            error = (f"no bound on the trilinear error: r <= √3 (a sharp edge or corner, or "
+                     f"a part or gap about {2 * self.r:.1f} voxels thin; Bærentzen eq. 22 "
+                     f"needs r > √3)")
         return (f"S_r-open up to r = {shown(self.r_open)}, S_r-closed up to r = "
-                f"{shown(self.r_closed)} voxels: "
+                f"{shown(self.r_closed)} voxels (to about {1 / self.oversample:g} voxel): "
                 f"{verdict} (r {'>' if self.suitable else '<='} √6 = {CRITICAL_RADIUS:.3f}); "
-                f"predicted trilinear error at most {self.predicted_error:.3g} voxels")
+                f"{error}")
 
 
 def suitability(shape: Any, resolution: Any = None, *, bounds: Any = None,
-                voxel_size: Any = None, oversample: int = 4, max_radius: float = 12.0,
-                max_memory: Optional[int] = None) -> Suitability:
+                voxel_size: Any = None, oversample: Optional[int] = None,
+                max_radius: float = 12.0, max_memory: Optional[int] = None) -> Suitability:
     """Estimate the largest ``r`` (voxels) for which ``shape`` is S_r-open and S_r-closed.
 
     Parameters
@@ -100,8 +115,10 @@ def suitability(shape: Any, resolution: Any = None, *, bounds: Any = None,
     shape : Expr or Shape
     resolution, bounds, voxel_size
         The target grid, as for :func:`implicitvox.voxelize`.
-    oversample : {1, 2, 4, 8}, default: 4
-        The fine grid's voxels per target voxel, per axis.
+    oversample : {1, 2, 4, 8}, optional
+        The fine grid's voxels per target voxel, per axis; by default the largest
+        of 4, 2 and 1 whose padded fine grid has at most
+        :data:`SUITABILITY_FINE_CELLS` voxels.
     max_radius : float, default: 12
         The largest radius tried (voxels); a solid open or closed beyond it
         reports ``max_radius``.
@@ -113,15 +130,23 @@ def suitability(shape: Any, resolution: Any = None, *, bounds: Any = None,
     Suitability
     """
     from scipy.ndimage import distance_transform_edt
-    oversample = validate.int_in(oversample, "oversample", 1, 8)
-    if oversample & (oversample - 1):
-        raise ValueError(f"oversample must be 1, 2, 4 or 8, got {oversample}")
+    if oversample is not None:
+        oversample = validate.int_in(oversample, "oversample", 1, 8)
+        if oversample & (oversample - 1):
+            raise ValueError(f"oversample must be 1, 2, 4 or 8, got {oversample}")
     max_radius = validate.number_in(max_radius, "max_radius", 0.5, 256.0)
     shape = as_shape(shape)
     grid = grid_of(getattr(shape, "bounds", None), bounds, resolution, voxel_size)
+
+    def padded_cells(k: int) -> tuple[int, int]:
+        pad = int(math.ceil(max_radius * k)) + 2
+        return int(np.prod(np.asarray(grid.shape) * k + 2 * pad, dtype=np.float64)), pad
+
+    if oversample is None:
+        oversample = next((k for k in (4, 2) if padded_cells(k)[0] <= SUITABILITY_FINE_CELLS),
+                          1)
     fine = grid.finer(int(math.log2(oversample)))
-    pad = int(math.ceil(max_radius * oversample)) + 2
-    cells = int(np.prod(np.asarray(fine.shape) + 2 * pad, dtype=np.float64))
+    cells, pad = padded_cells(oversample)
     refuse_over_budget(cells * 24, memory_budget(max_memory),
                        f"the suitability test on a {fine.shape} grid")
     solid = _solid(shape, fine, max_memory)
@@ -129,7 +154,7 @@ def suitability(shape: Any, resolution: Any = None, *, bounds: Any = None,
     limit = max_radius * oversample
     r_open = _largest_open(solid, limit, distance_transform_edt)
     r_closed = _largest_open(~solid, limit, distance_transform_edt)
-    return Suitability(r_open / oversample, r_closed / oversample, max_radius)
+    return Suitability(r_open / oversample, r_closed / oversample, max_radius, oversample)
 
 
 def _solid(shape, grid, max_memory) -> np.ndarray:
@@ -170,7 +195,8 @@ def _opens(solid: np.ndarray, rho: float, edt, depth: Optional[np.ndarray] = Non
 
 
 def _largest_open(solid: np.ndarray, limit: float, edt) -> float:
-    """The largest ``ρ <= limit`` (voxels) with ``solid`` S_ρ-open, by bisection."""
+    """The largest ``ρ <= limit`` (voxels) with ``solid`` S_ρ-open, by bisection to a
+    quarter of a voxel (the samples' own precision is about one)."""
     if not solid.any():
         return limit
     depth = edt(solid)
@@ -181,7 +207,7 @@ def _largest_open(solid: np.ndarray, limit: float, edt) -> float:
     if is_open(limit):
         return limit
     lo, hi = 0.0, limit
-    for _ in range(_STEPS):
+    for _ in range(max(1, math.ceil(math.log2(4 * limit)))):
         mid = 0.5 * (lo + hi)
         lo, hi = (mid, hi) if is_open(mid) else (lo, mid)
     return lo

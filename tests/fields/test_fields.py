@@ -262,11 +262,27 @@ def test_suitability_sphere_cube_and_two_close_spheres():
     cube = linf.ConvexPolyhedron.from_points(CUBE)
     s = iv.suitability(cube, 16, oversample=4, max_radius=4)
     assert s.r_open < 1 and not s.suitable
+    assert "no bound on the trilinear error" in str(s) and "inf" not in str(s)
     # two spheres 2 voxels apart: the gap closes for any ball wider than it, r ≈ 1
     pitch = 4.0 / 31
     pair = csg.Sphere(r=1.0) | csg.Sphere(r=1.0).translate((2 + 2 * pitch, 0, 0))
     s = iv.suitability(pair, 32, oversample=2, max_radius=4)
     assert 0.5 <= s.r_closed <= 1.5 and s.r_open > 3 and not s.suitable
+
+
+def test_suitability_takes_the_finest_grid_memory_holds(monkeypatch):
+    # by default the finest of 4, 2, 1 fine voxels per voxel whose padded grid has at
+    # most SUITABILITY_FINE_CELLS voxels; coarser, the answer is still near r
+    import importlib
+    module = importlib.import_module("implicitvox.fields.suitability")
+    sphere = linf.Sphere((0, 0, 0), 1.0)
+    assert iv.suitability(sphere, 21, max_radius=12).oversample == 4
+    monkeypatch.setattr(module, "SUITABILITY_FINE_CELLS", 100 ** 3)
+    s = iv.suitability(sphere, 21, max_radius=12)
+    assert s.oversample == 2 and 9 <= s.r_open <= 10.5 and s.suitable
+    monkeypatch.setattr(module, "SUITABILITY_FINE_CELLS", 10)
+    s = iv.suitability(sphere, 21, max_radius=12)
+    assert s.oversample == 1 and 8.5 <= s.r_open <= 10.5 and "about 1 voxel" in str(s)
 
 
 def test_files_round_trip_and_refuse_bad_input(tmp_path):
