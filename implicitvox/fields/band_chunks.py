@@ -30,8 +30,8 @@ __all__ = ["DistanceKernel", "SamplesJob", "band_distances", "CHUNK", "COST"]
 
 #: samples computed per call, by the kernel's cost (:attr:`DistanceKernel.cost`):
 #: bounded temporaries, progress steps, one farmed piece (a certified search takes
-#: about a millisecond per sample, so its pieces are small enough for the queue to
-#: balance)
+#: a few tenths of a millisecond per sample, so its pieces are small enough for the
+#: queue to balance)
 CHUNK = {"analytic": 1 << 16, "mesh": 1 << 14, "box test": 1 << 14, "certified": 1 << 11}
 #: cost of one sample, in surface voxels of the voxelizer (for ``workers=None``'s
 #: "does it pay"): analytic distances, a hierarchy walk, a box-test bisection,

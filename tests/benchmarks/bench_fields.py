@@ -80,23 +80,29 @@ def child(name: str, res: int, method: str) -> dict:
             out["error"] = float(np.abs(np.abs(values[pick]) - brute).max()) / h
         elif name == "torus":
             out["error"] = float(np.abs(values[pick] - shape.euclidean_distance(p)).max()) / h
-        np.savez(_cache(name, res), coords=coords, values=values)
+        grid = field.grid
+        np.savez(_cache(name, res), coords=coords, values=values,
+                 bounds=np.asarray(grid.bounds, dtype=np.float64),
+                 voxel_size=np.asarray(grid.voxel_size, dtype=np.float64))
         return out
-    # the baseline, on the same grid, timed from the voxelization on
+    # the baseline, on the field's grid (its bounds reach past the surface by the
+    # band), timed from the voxelization on
     from implicitvox.fields.suitability import solid_voxels
+    cached = np.load(_cache(name, res))
+    grid = {"bounds": tuple(map(tuple, cached["bounds"])),
+            "voxel_size": tuple(cached["voxel_size"])}
     t = time.perf_counter()
     if name == "bunny-linf":
         triangles = (shape.tri.reshape(-1, 3), np.arange(3 * len(shape.tri)).reshape(-1, 3))
-        vox = ivx.voxelize_mesh(triangles, res)
+        vox = ivx.voxelize_mesh(triangles, **grid)
         dense = vox.to_dense(interior=False)
         signed = ndimage.distance_transform_cdt(~dense, metric="chessboard").astype(np.float64)
     else:
-        vox = ivx.voxelize(shape, res, interior=True)
+        vox = ivx.voxelize(shape, interior=True, **grid)
         solid = solid_voxels(vox, shape)
         signed = ndimage.distance_transform_edt(~solid) - ndimage.distance_transform_edt(solid)
     seconds = time.perf_counter() - t
     out = {"seconds": seconds, "peak": tables.peak_bytes(), "samples": int(signed.size)}
-    cached = np.load(_cache(name, res))
     c, ours = cached["coords"], cached["values"]
     h = min(vox.grid.voxel_size)
     theirs = signed[c[:, 0], c[:, 1], c[:, 2]]
