@@ -342,30 +342,43 @@ def _bracket(ev, euclidean, p, w, tree, boxes_lo, boxes_hi, half_diag, scale, li
 
 
 def _refine(ev, euclidean, p, w, pt, box, lo, hi, level, state, limit, tolerance, max_levels,
-            stats):
+            stats, parent=None):
     """Bound, prune and split the pairs ``(pt, box)`` level by level (``pt`` sorted;
-    ``box`` indexes the boxes ``lo, hi`` (3, m) of this level, each evaluated once);
+    ``box`` indexes the boxes ``lo, hi`` (3, m) of this level, each evaluated once;
+    ``parent``: the per-box arrays of their parents, box ``b``'s being ``b >> 3``);
     where the children would exceed :data:`MAX_PAIRS`, the points are halved and each
     half refined on its own (a point's pairs stay together, so its bounds come from
     all of them)."""
     upper, lower, open_, parked = state["upper"], state["lower"], state["open"], state["parked"]
+    inner = (state["interior_lo"], state["interior_hi"])
+    kernels = ev.kernels
     n = len(p)
     while len(pt):
         keep = np.empty(len(pt), dtype=bool)
-        ev.kernels.shell_pairs(euclidean, p, w, pt, lo, hi, box, lower, np.minimum(upper, limit),
-                               keep)
-        pt, box, lo, hi = _kept_boxes(pt[keep], box[keep], lo, hi)
+        reach = np.minimum(upper, limit)
+        alive = np.zeros(n, dtype=bool)
+        kernels.shell_pairs(euclidean, p, w, pt, lo, hi, box, lower, reach, parent is not None,
+                            *(parent or _NO_PARENT), *inner, keep, alive)
+        # a point left without pairs has no zero nearer than its reach but in its
+        # parked boxes
+        gone = pt[np.r_[True, pt[1:] != pt[:-1]]]
+        gone = gone[~alive[gone]]
+        lower[gone] = np.where(open_[gone], np.minimum(parked[gone], reach[gone]), lower[gone])
+        open_[gone] = False
+        pt, box, lo, hi, _ = _kept_boxes(pt[keep], box[keep], lo, hi)
         if not len(pt):
             return
         mine = pt[np.r_[True, pt[1:] != pt[:-1]]]
         vlo, vhi, glo, ghi, valid = ev.boxes(lo, hi)
         clo, chi = ev.at(0.5 * (lo + hi))
+        m = lo.shape[1]
+        slabs = (np.empty((3, m)), np.empty(m), np.empty(m), np.empty(m, dtype=bool))
+        kernels.box_slabs(lo, hi, vlo, vhi, glo, ghi, valid, clo, chi, *slabs)
         lb = np.empty(len(pt))
         lead = np.full(n, -1, dtype=np.int64)
         lead_q, lead_unit, lead_delta = np.empty((n, 3)), np.empty((n, 3)), np.empty(n)
-        ev.kernels.pair_bounds(euclidean, p, w, pt, box, lo, hi, vlo, vhi, glo, ghi, valid, clo,
-                               chi, state["interior_lo"], state["interior_hi"], lb, lead, lead_q,
-                               lead_unit, lead_delta)
+        kernels.pair_bounds(euclidean, p, w, pt, box, lo, hi, *slabs, glo, ghi, valid, *inner,
+                            lb, lead, lead_q, lead_unit, lead_delta)
         # a candidate zero for each point, from its box of least bound: the point's
         # nearest point on the slab's middle plane, clipped to the box, then two
         # Newton steps, certified by a short segment across the surface
@@ -379,7 +392,7 @@ def _refine(ev, euclidean, p, w, pt, box, lo, hi, level, state, limit, tolerance
         reach = np.minimum(upper, limit)
         best = np.full(n, np.inf)
         keep = np.empty(len(pt), dtype=bool)
-        ev.kernels.settle_pairs(pt, lb, reach, best, keep)
+        kernels.settle_pairs(pt, lb, reach, best, keep)
         pt, box, lb = pt[keep], box[keep], lb[keep]
         least = np.minimum(np.minimum(best[mine], parked[mine]), reach[mine])
         lower[mine] = np.where(open_[mine], least, lower[mine])
@@ -392,7 +405,8 @@ def _refine(ev, euclidean, p, w, pt, box, lo, hi, level, state, limit, tolerance
         pt, box = pt[still], box[still]
         if level == max_levels or not len(pt):
             return
-        pt, box, lo, hi = _split(pt, box, lo, hi)
+        pt, box, lo, hi, used = _split(pt, box, lo, hi)
+        parent = [a[..., used] for a in (*slabs, glo, ghi, valid)]
         level += 1
         stats["pairs"] += len(pt)
         if len(pt) > MAX_PAIRS:
@@ -403,25 +417,31 @@ def _refine(ev, euclidean, p, w, pt, box, lo, hi, level, state, limit, tolerance
             first = pt < points[len(points) // 2]
             for half in (first, ~first):
                 _refine(ev, euclidean, p, w, pt[half], box[half], lo, hi, level, state, limit,
-                        tolerance, max_levels, stats)
+                        tolerance, max_levels, stats, parent)
             return
 
 
+#: the parents' arrays of :func:`certified_kernels.shell_pairs` at the first level (none)
+_NO_PARENT = (np.empty((3, 0)), np.empty(0), np.empty(0), np.empty(0, dtype=bool),
+              np.empty((3, 0)), np.empty((3, 0)), np.empty(0, dtype=bool))
+
+
 def _kept_boxes(pt, box, lo, hi):
-    """The pairs ``(pt, box)`` on a box table holding only the boxes they name."""
+    """The pairs ``(pt, box)`` on a box table holding only the boxes they name (and
+    which of the old ones those are)."""
     used = np.zeros(lo.shape[1], dtype=bool)
     used[box] = True
     index = np.cumsum(used) - 1
-    return pt, index[box], lo[:, used], hi[:, used]
+    return pt, index[box], lo[:, used], hi[:, used], used
 
 
 def _split(pt, box, lo, hi):
     """Each box that still has pairs into its 8 children (box ``k`` of those kept
-    becomes boxes ``8k .. 8k + 7``), each pair into 8."""
-    pt, box, ulo, uhi = _kept_boxes(pt, box, lo, hi)
+    becomes boxes ``8k .. 8k + 7``), each pair into 8; and which boxes were kept."""
+    pt, box, ulo, uhi, used = _kept_boxes(pt, box, lo, hi)
     mid = 0.5 * (ulo + uhi)
     upper_half = _CORNERS.T[:, None, :]                                 # (3, 1, 8)
     clo = np.where(upper_half, mid[:, :, None], ulo[:, :, None]).reshape(3, -1)
     chi = np.where(upper_half, uhi[:, :, None], mid[:, :, None]).reshape(3, -1)
     children = (box[:, None] * 8 + np.arange(8)[None]).reshape(-1)
-    return np.repeat(pt, 8), children, clo, chi
+    return np.repeat(pt, 8), children, clo, chi, used

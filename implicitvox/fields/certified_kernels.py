@@ -32,9 +32,10 @@ import math
 import numpy as np
 from numba import njit
 
-from ..interval.rules import COMPILE, i_addc, i_mul, i_sub
+from ..interval.rules import COMPILE
 
-__all__ = ["pair_bounds", "settle_pairs", "euclidean_box_slab", "linf_box_slab", "first_reach"]
+__all__ = ["box_slabs", "pair_bounds", "settle_pairs", "shell_pairs", "euclidean_box_slab",
+           "linf_box_slab", "first_reach"]
 
 _EPS = float(np.finfo(np.float64).eps)
 _INF = math.inf
@@ -177,35 +178,98 @@ def _excludes_normals(p, lo, hi, glo, ghi, b):
     """Is ``q - p`` parallel to no ``ξ ∈ [∇f](box)`` for any ``q`` in box ``b``? (Some
     component of the cross product ``(q - p) × ξ``, enclosed with outward rounding,
     excludes 0.)"""
+    return _excludes_normals_of(p, lo, hi, b, glo, ghi, b)
+
+
+@njit(**COMPILE)
+def _product_range(al, ah, bl, bh):
+    """The least and greatest of the four products of ``[al, ah] × [bl, bh]`` as
+    computed, and their largest magnitude."""
+    p0, p1, p2, p3 = al * bl, al * bh, ah * bl, ah * bh
+    least = min(min(p0, p1), min(p2, p3))
+    most = max(max(p0, p1), max(p2, p3))
+    return least, most, max(abs(least), abs(most))
+
+
+@njit(**COMPILE)
+def _excludes_normals_of(p, lo, hi, b, glo, ghi, a):
+    """:func:`_excludes_normals` for box ``b`` with the gradient enclosure ``a`` (of a
+    box holding ``b``). In floating point, each component's range widened by 4 ulps
+    of its terms' magnitudes (above the few roundings of the offsets, products and
+    difference)."""
     for j in range(3):
         k, m = (j + 1) % 3, (j + 2) % 3
-        ukl, ukh = i_addc(lo[k, b], hi[k, b], -p[k])
-        uml, umh = i_addc(lo[m, b], hi[m, b], -p[m])
-        al, ah = i_mul(ukl, ukh, glo[m, b], ghi[m, b])
-        bl, bh = i_mul(uml, umh, glo[k, b], ghi[k, b])
-        cl, ch = i_sub(al, ah, bl, bh)
-        if cl > 0.0 or ch < 0.0:
+        l0, h0, m0 = _product_range(lo[k, b] - p[k], hi[k, b] - p[k], glo[m, a], ghi[m, a])
+        l1, h1, m1 = _product_range(lo[m, b] - p[m], hi[m, b] - p[m], glo[k, a], ghi[k, a])
+        slack = 4.0 * _EPS * (m0 + m1)
+        if l0 - h1 - slack > 0.0 or h0 - l1 + slack < 0.0:
             return True
     return False
 
 
 @njit(**COMPILE)
-def pair_bounds(euclidean, p, w, pt, box, lo, hi, vlo, vhi, glo, ghi, valid, clo, chi,
+def box_slabs(lo, hi, vlo, vhi, glo, ghi, valid, clo, chi, g, s_lo, s_hi, slab):
+    """Per box ``b``: may it hold a zero (its enclosure holds 0; else ``slab[b]`` is
+    False and ``s_lo[b] = inf``), and the slab of the mean value form that holds its
+    zeros, ``s_lo[b] <= g[:, b]·q <= s_hi[b]``: ``f(q) ∈ [f(c)] + [∇f]·(q - c)``, so a
+    zero has ``g·(q - c) ∈ -[f(c)] ∓ Σ_i rad([∇f]_i) h_i`` (``g`` the gradient
+    enclosure's midpoint, ``h`` the half-sizes), widened by the roundings of these
+    few operations; ``slab[b]`` is False where the slab is not proved (the mean value
+    theorem fails, a zero gradient midpoint, an overflow)."""
+    for b in range(lo.shape[1]):
+        slab[b] = False
+        if not (vlo[b] <= 0.0 and vhi[b] >= 0.0):
+            s_lo[b], s_hi[b] = _INF, -_INF
+            continue
+        gc = spread = norm = 0.0
+        for j in range(3):
+            g[j, b] = 0.5 * (glo[j, b] + ghi[j, b])
+            spread += 0.5 * (ghi[j, b] - glo[j, b]) * (0.5 * (hi[j, b] - lo[j, b]))
+            gc += g[j, b] * (0.5 * (lo[j, b] + hi[j, b]))
+            norm += g[j, b] * g[j, b]
+        c_lo, c_hi = clo[b], chi[b]
+        slack = 8.0 * _EPS * (abs(gc) + max(abs(c_lo), abs(c_hi)) + spread)
+        s_lo[b] = gc - c_hi - spread - slack
+        s_hi[b] = gc - c_lo + spread + slack
+        slab[b] = valid[b] and c_lo <= c_hi and norm > 0.0 and math.isfinite(norm) \
+            and math.isfinite(s_lo[b]) and math.isfinite(s_hi[b])
+
+
+@njit(**COMPILE)
+def _to_box_and_slab(euclidean, p, s, w, lo, hi, b, s_lo, s_hi, q, ww, blo, bhi, gb, scratch):
+    """The distances from sample ``p[s]`` to box ``b`` of ``lo, hi`` and to the box's
+    part in the slab ``s_lo <= gb·q <= s_hi`` (``inf`` where it is empty; ``q, ww,
+    blo, bhi`` are room for 3 floats each, ``scratch`` for 9)."""
+    gap2 = gapm = 0.0
+    for j in range(3):
+        q[j], ww[j] = p[s, j], w[s, j]
+        blo[j], bhi[j] = lo[j, b], hi[j, b]
+        gap = max(max(blo[j] - q[j], q[j] - bhi[j]), 0.0)
+        gap2 += gap * gap
+        gapm = max(gapm, gap / ww[j])
+    to_box = math.sqrt(gap2) if euclidean else gapm
+    if euclidean:
+        to_both = euclidean_box_slab(q, blo, bhi, gb, s_lo, s_hi, scratch)
+    else:
+        to_both = linf_box_slab(q, ww, blo, bhi, gb, s_lo, s_hi, scratch)
+    return to_box, to_both
+
+
+@njit(**COMPILE)
+def pair_bounds(euclidean, p, w, pt, box, lo, hi, g, s_lo, s_hi, slab, glo, ghi, valid,
                 interior_lo, interior_hi, lb, lead, lead_q, lead_unit, lead_delta):
     """Per pair ``(pt[k], box[k])``: ``lb[k]``, a lower bound of the distance from
-    sample ``p[pt[k]]`` to the zeros of ``f`` in box ``box[k]`` (``inf`` where its
-    enclosure excludes 0). The box's zeros lie in the slab of the mean value form,
-    ``g·(q - c) ∈ -[f(c)] ∓ Σ_i rad([∇f]_i) h_i`` (``g`` the gradient enclosure's
-    midpoint, ``h`` the half-sizes), widened by the roundings of these few
-    operations; the bound is the distance to box ∩ slab, or to the box where the
-    slab is not proved.
+    sample ``p[pt[k]]`` to the zeros of ``f`` in box ``box[k]``: the distance to box ∩
+    slab (:func:`box_slabs`), or to the box where the slab is not proved; ``inf``
+    where the box holds no zero.
 
     Euclidean pairs whose box lies strictly inside ``(interior_lo, interior_hi)``
     and holds no point ``q`` where ``q - p`` is parallel to a gradient (Clarke's
     generalized gradient where ``f`` has kinks) get ``inf`` too: the nearest zero
     ``q*`` within the domain, if it is not on the domain's boundary, satisfies the
     Fritz John condition ``q* - p ∥ ξ``, ``ξ ∈ ∂f(q*)``, wherever ``f`` is
-    Lipschitz (the box is valid), so such a box does not hold it; every other box's
+    Lipschitz (the box is valid: its gradient enclosure ``glo, ghi`` holds the
+    gradients on the closed box), so such a box does not hold it; every other box's
     bound stays, and the least of them is still a lower bound of the distance.
 
     Per sample, ``lead[s]`` is its pair of least bound if that pair's slab holds
@@ -215,58 +279,25 @@ def pair_bounds(euclidean, p, w, pt, box, lo, hi, vlo, vhi, glo, ghi, valid, clo
     ``lead`` must hold -1 on entry; boxes' arrays are per box (``(3, m)`` for the
     vectors), the rest per pair."""
     best = np.full(lead.size, _INF)
-    q = np.empty(3)
-    ww = np.empty(3)
-    blo = np.empty(3)
-    bhi = np.empty(3)
-    g = np.empty(3)
+    q, ww, blo, bhi, gb = np.empty(3), np.empty(3), np.empty(3), np.empty(3), np.empty(3)
     scratch = np.empty(9)
     slab_ok = np.zeros(pt.size, dtype=np.bool_)
-    s_mid = np.empty(pt.size)
     for k in range(pt.size):
         s, b = pt[k], box[k]
-        gap2 = 0.0
-        gapm = 0.0
-        gc = 0.0
-        gp = 0.0
-        spread = 0.0
-        dual2 = 0.0
-        dual1 = 0.0
-        for j in range(3):
-            q[j], ww[j] = p[s, j], w[s, j]
-            blo[j], bhi[j] = lo[j, b], hi[j, b]
-            gap = max(max(blo[j] - q[j], q[j] - bhi[j]), 0.0)
-            gap2 += gap * gap
-            gapm = max(gapm, gap / ww[j])
-            g[j] = 0.5 * (glo[j, b] + ghi[j, b])
-            spread += 0.5 * (ghi[j, b] - glo[j, b]) * (0.5 * (bhi[j] - blo[j]))
-            gc += g[j] * (0.5 * (blo[j] + bhi[j]))
-            gp += g[j] * q[j]
-            dual2 += g[j] * g[j]
-            dual1 += abs(g[j]) * ww[j]
-        if not (vlo[b] <= 0.0 and vhi[b] >= 0.0):
+        if not s_lo[b] <= s_hi[b]:                   # no zero in the box
             lb[k] = _INF
             continue
-        to_box = math.sqrt(gap2) if euclidean else gapm
-        dual = math.sqrt(dual2) if euclidean else dual1
-        c_lo, c_hi = clo[b], chi[b]
-        slack = 8.0 * _EPS * (abs(gc) + max(abs(c_lo), abs(c_hi)) + spread)
-        s_lo = gc - c_hi - spread - slack
-        s_hi = gc - c_lo + spread + slack
-        to_slab = max(max(s_lo - gp, gp - s_hi), 0.0) / dual
-        if euclidean:
-            to_both = euclidean_box_slab(q, blo, bhi, g, s_lo, s_hi, scratch)
-        else:
-            to_both = linf_box_slab(q, ww, blo, bhi, g, s_lo, s_hi, scratch)
-        ok = valid[b] and dual > 0.0 and math.isfinite(to_slab) and c_lo <= c_hi \
-            and not math.isnan(to_both)
+        for j in range(3):
+            gb[j] = g[j, b]
+        to_box, to_both = _to_box_and_slab(euclidean, p, s, w, lo, hi, b, s_lo[b], s_hi[b], q,
+                                           ww, blo, bhi, gb, scratch)
+        ok = slab[b] and not math.isnan(to_both)
         lb[k] = max(to_box, to_both) if ok else to_box
         if euclidean and valid[b] and _inside(lo, hi, b, interior_lo, interior_hi) \
                 and _excludes_normals(p[s], lo, hi, glo, ghi, b):
             lb[k] = _INF
             continue
         slab_ok[k] = ok
-        s_mid[k] = ((s_lo + s_hi) / 2 - gp) / dual
         if lb[k] < best[s]:
             best[s] = lb[k]
             lead[s] = k
@@ -278,20 +309,23 @@ def pair_bounds(euclidean, p, w, pt, box, lo, hi, vlo, vhi, glo, ghi, valid, clo
             lead[s] = -1
             continue
         b = box[k]
-        norm = 0.0
-        size = 0.0
-        centre = 0.0
+        norm = gp = dual1 = 0.0
         for j in range(3):
-            g[j] = 0.5 * (glo[j, b] + ghi[j, b])
-            norm += g[j] * g[j]
+            norm += g[j, b] * g[j, b]
+            gp += g[j, b] * p[s, j]
+            dual1 += abs(g[j, b]) * w[s, j]
         norm = math.sqrt(norm)
+        dual = norm if euclidean else dual1
+        mid = ((s_lo[b] + s_hi[b]) / 2 - gp) / dual
+        size = centre = 0.0
         for j in range(3):
-            step = g[j] / norm if euclidean else math.copysign(w[s, j], g[j]) * (g[j] != 0.0)
+            step = g[j, b] / norm if euclidean else \
+                math.copysign(w[s, j], g[j, b]) * (g[j, b] != 0.0)
             c = 0.5 * (lo[j, b] + hi[j, b])
-            v = p[s, j] + s_mid[k] * step
+            v = p[s, j] + mid * step
             v = v if math.isfinite(v) else c
             lead_q[s, j] = _clip(v, lo[j, b], hi[j, b])
-            u = g[j] / norm
+            u = g[j, b] / norm
             lead_unit[s, j] = u if math.isfinite(u) else 0.0
             size = max(size, 0.5 * (hi[j, b] - lo[j, b]))
             centre = max(centre, abs(c))
@@ -312,11 +346,18 @@ def settle_pairs(pt, lb, reach, best, keep):
 
 
 @njit(**COMPILE)
-def shell_pairs(euclidean, p, w, pt, lo, hi, box, lower, reach, keep):
-    """``keep[k]``: box ``box[k]`` meets the shell ``lower[s] <= |q - p[s]| <= reach[s]``
-    of its sample ``s = pt[k]``, where its nearest zero lies (a box wholly nearer
-    than the proved lower bound holds no zero; one wholly past the reach need not
-    be searched)."""
+def shell_pairs(euclidean, p, w, pt, lo, hi, box, lower, reach, parents, g, s_lo, s_hi, slab,
+                glo, ghi, valid, interior_lo, interior_hi, keep, alive):
+    """``keep[k]``: box ``box[k]`` may hold the nearest zero of its sample ``s =
+    pt[k]``, by what is known before evaluating it: it meets the shell ``lower[s]
+    <= |q - p[s]| <= reach[s]`` (a box wholly nearer than the proved lower bound
+    holds no zero; one wholly past the reach need not be searched), and, when
+    ``parents`` (box ``b``'s parent is box ``b >> 3`` of the per-box arrays, from
+    :func:`box_slabs` and the gradient enclosures), it meets the parent's slab, the
+    slab is within the reach, and the parent's gradients pass the Fritz John test
+    of :func:`pair_bounds` on it (the parent's enclosures hold the child's). (Cheap
+    tests only: the exact distance to box ∩ slab costs about what evaluating the
+    box does.) ``alive[s]`` is set True for each sample with a pair kept."""
     for k in range(pt.size):
         s, b = pt[k], box[k]
         near2 = far2 = near = far = 0.0
@@ -330,4 +371,33 @@ def shell_pairs(euclidean, p, w, pt, lo, hi, box, lower, reach, keep):
             far = max(far, span / w[s, j])
         if euclidean:
             near, far = math.sqrt(near2), math.sqrt(far2)
-        keep[k] = near <= reach[s] * (1.0 + 4.0 * _EPS) and far >= lower[s] * (1.0 - 4.0 * _EPS)
+        limit = reach[s] * (1.0 + 4.0 * _EPS)
+        keep[k] = near <= limit and far >= lower[s] * (1.0 - 4.0 * _EPS)
+        if not keep[k] or not parents:
+            continue
+        a = b >> 3
+        if slab[a]:
+            # the child's part in the parent's slab: empty, or beyond the reach?
+            # (the sums' rounding errors: below 4 eps times the sums of magnitudes)
+            least = most = gp = dual2 = dual1 = size = at = 0.0
+            for j in range(3):
+                gj = g[j, a]
+                least += gj * (lo[j, b] if gj >= 0.0 else hi[j, b])
+                most += gj * (hi[j, b] if gj >= 0.0 else lo[j, b])
+                gp += gj * p[s, j]
+                dual2 += gj * gj
+                dual1 += abs(gj) * w[s, j]
+                size += abs(gj) * max(abs(lo[j, b]), abs(hi[j, b]))
+                at += abs(gj * p[s, j])
+            dual = math.sqrt(dual2) if euclidean else dual1
+            slack, off = 4.0 * _EPS * size, 4.0 * _EPS * at
+            to_slab = max(max(s_lo[a] - gp - off, gp - s_hi[a] - off), 0.0) / dual
+            if most + slack < s_lo[a] or least - slack > s_hi[a] or to_slab > limit:
+                keep[k] = False
+                continue
+        if euclidean and valid[a] and _inside(lo, hi, b, interior_lo, interior_hi) \
+                and _excludes_normals_of(p[s], lo, hi, b, glo, ghi, a):
+            keep[k] = False
+    for k in range(pt.size):
+        if keep[k]:
+            alive[pt[k]] = True
