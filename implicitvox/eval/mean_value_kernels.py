@@ -42,9 +42,9 @@ from numba import njit
 
 from ..interval.rules import (COMPILE, i_abs, i_acos, i_add, i_addc, i_asin, i_atan, i_atan2,
                               i_cos, i_distance, i_div, i_divc, i_elevation, i_exp, i_floor,
-                              i_hypot, i_log, i_max, i_min, i_mul, i_mulc, i_neg,
-                              i_periodic_angle, i_powi, i_powr, i_radius, i_rsubc, i_sin, i_sqrt,
-                              i_square, i_sub, i_tan)
+                              i_hypot, i_log, i_max, i_min, i_mul, i_mulc, i_neg, i_powi,
+                              i_powr, i_radius, i_rsubc, i_sin, i_sqrt, i_square, i_sub, i_tan,
+                              periodic_angle_argument)
 from .compiled import (ABS, ACOS, ADD, ADDC, ASIN, ATAN, ATAN2, COS, DISTANCE, DIV, DIVC,
                        ELEVATION, EXP, FLOOR, HYPOT, LOG, MAX, MIN, MUL, MULC, NEG,
                        PERIODIC_ANGLE, POWI, POWR, RADIUS, RSUBC, SIN, SQRT, SQUARE, SUB, TAN,
@@ -246,11 +246,15 @@ def run_gradients(code, params, creg, clo, chi, inputs, output, lo, hi, vlo, vhi
             elif op == PERIODIC_ANGLE:
                 bl, bh = rl[b], rh[b]
                 k, phase = params[j, 1], params[j, 2]
-                ol, oh = i_periodic_angle(al, ah, bl, bh, p0, k, phase)
+                # (rules.i_periodic_angle, its argument shared with the slope's)
+                tl, th = periodic_angle_argument(al, ah, bl, bh, k, phase)
                 ok = ok and not _holds_origin(al, ah, bl, bh)
-                sl, sh = i_periodic_angle(al, ah, bl, bh, 1.0 - p0, k, phase)
                 if p0 == 1.0:                            # cos: the slope is -sin
-                    sl, sh = i_neg(sl, sh)
+                    ol, oh = i_cos(tl, th)
+                    sl, sh = i_neg(*i_sin(tl, th))
+                else:
+                    ol, oh = i_sin(tl, th)
+                    sl, sh = i_cos(tl, th)
                 _angle_rate(al, ah, bl, bh, a, b, True, *i_mulc(sl, sh, k), o, gl, gh)
             elif op == ELEVATION:
                 bl, bh, cl, ch = rl[b], rh[b], rl[c], rh[c]

@@ -287,16 +287,16 @@ def pair_bounds(euclidean, p, w, pt, box, lo, hi, g, s_lo, s_hi, slab, glo, ghi,
         if not s_lo[b] <= s_hi[b]:                   # no zero in the box
             lb[k] = _INF
             continue
+        if euclidean and valid[b] and _inside(lo, hi, b, interior_lo, interior_hi) \
+                and _excludes_normals(p[s], lo, hi, glo, ghi, b):
+            lb[k] = _INF
+            continue
         for j in range(3):
             gb[j] = g[j, b]
         to_box, to_both = _to_box_and_slab(euclidean, p, s, w, lo, hi, b, s_lo[b], s_hi[b], q,
                                            ww, blo, bhi, gb, scratch)
         ok = slab[b] and not math.isnan(to_both)
         lb[k] = max(to_box, to_both) if ok else to_box
-        if euclidean and valid[b] and _inside(lo, hi, b, interior_lo, interior_hi) \
-                and _excludes_normals(p[s], lo, hi, glo, ghi, b):
-            lb[k] = _INF
-            continue
         slab_ok[k] = ok
         if lb[k] < best[s]:
             best[s] = lb[k]

@@ -52,7 +52,8 @@ __all__ = [
     "i_add", "i_sub", "i_mul", "i_div", "i_neg", "i_addc", "i_rsubc", "i_mulc", "i_divc",
     "i_square", "i_powi", "i_powr", "i_sqrt", "i_abs", "i_exp", "i_log", "i_sin", "i_cos",
     "i_tan", "i_atan", "i_asin", "i_acos", "i_atan2", "i_hypot", "i_min", "i_max", "i_floor",
-    "i_radius", "i_distance", "i_elevation", "i_periodic_angle", "COMPILE",
+    "i_radius", "i_distance", "i_elevation", "i_periodic_angle", "periodic_angle_argument",
+    "unwrapped_angle", "COMPILE",
 ]
 
 def _probe() -> int:
@@ -518,10 +519,19 @@ def unwrapped_angle(vlo, vhi, ulo, uhi):
 
 
 @njit(**COMPILE)
-def i_periodic_angle(vlo, vhi, ulo, uhi, is_cos, k, c):
-    """``sin`` (``cos``) of ``k * atan2(v, u) + c``, ``k`` an integer, tight across the cut."""
+def periodic_angle_argument(vlo, vhi, ulo, uhi, k, c):
+    """``k * atan2(v, u) + c`` over a box, unwrapped across the cut: the argument of
+    :func:`i_periodic_angle` (whose ``sin`` and ``cos`` are then :func:`i_sin` and
+    :func:`i_cos` of it)."""
     alo, ahi = unwrapped_angle(vlo, vhi, ulo, uhi)
     alo, ahi = i_mulc(alo, ahi, k)
     if c != 0.0:
         alo, ahi = i_addc(alo, ahi, c)
+    return alo, ahi
+
+
+@njit(**COMPILE)
+def i_periodic_angle(vlo, vhi, ulo, uhi, is_cos, k, c):
+    """``sin`` (``cos``) of ``k * atan2(v, u) + c``, ``k`` an integer, tight across the cut."""
+    alo, ahi = periodic_angle_argument(vlo, vhi, ulo, uhi, k, c)
     return _periodic(alo, ahi, is_cos)
