@@ -70,6 +70,8 @@ MAX_PAIRS = 1 << 19
 _BLOCK = 4096
 _NEWTON = 8
 _MARGIN = 2.0 ** -40
+#: points from which Newton estimates come from the array evaluator
+_ARRAY_ESTIMATES = 256
 #: the 8 children of a box: per child, which axes take the upper half
 _CORNERS = np.array(list(np.ndindex(2, 2, 2)), dtype=bool)          # (8, 3)
 
@@ -111,11 +113,12 @@ class _Enclosures:
 
     def estimates(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Values (n,) and gradients (n, 3) near ``f``'s and ``∇f``'s at the points
-        ``q`` (n, 3), for Newton steps (the midpoints of their enclosures; the array
-        evaluator's floats for a tape with a sweep)."""
+        ``q`` (n, 3), for Newton steps: the midpoints of their compiled enclosures
+        for a few points, the array evaluator's floats for many (its numpy calls
+        cost less per point there) or for a tape with a sweep."""
         n = len(q)
         with np.errstate(all="ignore"):
-            if self.compiled is not None:
+            if self.compiled is not None and n < _ARRAY_ESTIMATES:
                 qt = np.ascontiguousarray(q.T)
                 vlo, vhi, glo, ghi, _ = self.gradients(self.tape, qt, qt, libm=True)
                 return 0.5 * (vlo + vhi), (0.5 * (glo + ghi)).T
@@ -141,20 +144,26 @@ def _certified_upper(ev: _Enclosures, euclidean: bool, p: np.ndarray, w: np.ndar
                      q: np.ndarray, direction: np.ndarray, delta: np.ndarray) -> np.ndarray:
     """Upper bounds from short segments through ``q`` whose ends have proved opposite
     signs (``inf`` where none): ``q ± delta·direction`` (across the surface where
-    ``direction`` is its normal), and ``q ± delta·(q - p) / |q - p|``, along the ray
-    from the point (across it where ``q`` is near the nearest zero, also at a kink of
-    the surface, where the gradient at ``q`` is one side's)."""
+    ``direction`` is its normal), and where that fails ``q ± delta·(q - p) / |q - p|``,
+    along the ray from the point (across it where ``q`` is near the nearest zero,
+    also at a kink of the surface, where the gradient at ``q`` is one side's)."""
     with np.errstate(all="ignore"):
         ray = (q - p) / np.linalg.norm(q - p, axis=1, keepdims=True)
     best = np.full(len(p), np.inf)
+    todo = np.arange(len(p))
     for u in (direction, ray):
-        a = q - delta[:, None] * u
-        b = q + delta[:, None] * u
+        u, at, d = u[todo], q[todo], delta[todo]
+        a = at - d[:, None] * u
+        b = at + d[:, None] * u
         finite = np.all(np.isfinite(a), axis=1) & np.all(np.isfinite(b), axis=1)
         a, b = np.where(finite[:, None], a, 0.0), np.where(finite[:, None], b, 0.0)
         ok = (_signs(ev, a) * _signs(ev, b) < 0) & finite
-        far = np.maximum(_length(a - p, w, euclidean), _length(b - p, w, euclidean))
-        best = np.minimum(best, np.where(ok, far * (1 + _MARGIN), np.inf))
+        far = np.maximum(_length(a - p[todo], w[todo], euclidean),
+                         _length(b - p[todo], w[todo], euclidean))
+        best[todo] = np.where(ok, far * (1 + _MARGIN), np.inf)
+        todo = todo[~ok]
+        if not len(todo):
+            break
     return best
 
 
@@ -190,13 +199,22 @@ def _ray_upper(ev: _Enclosures, euclidean: bool, p: np.ndarray, w: np.ndarray, q
 
 def _newton(ev: _Enclosures, q: np.ndarray, steps: int) -> np.ndarray:
     """Newton steps ``q <- q - f(q) ∇f / |∇f|²`` towards the surface (lanes where a
-    step is not finite stay)."""
+    step is not finite stay; lanes whose step falls below 2**-40 of their size
+    stop)."""
+    q = q.copy()
+    live = np.arange(len(q))
     with np.errstate(all="ignore"):
         for _ in range(steps):
-            v, g = ev.estimates(q)
+            v, g = ev.estimates(q[live])
             gg = np.einsum("ij,ij->i", g, g)
             move = np.where((gg > 0)[:, None], -(v / np.where(gg > 0, gg, 1))[:, None] * g, 0.0)
-            q = np.where(np.all(np.isfinite(move), axis=1)[:, None], q + move, q)
+            moving = np.all(np.isfinite(move), axis=1)
+            q[live[moving]] += move[moving]
+            small = np.max(np.abs(move), axis=1) <= _MARGIN * (1.0 + np.max(np.abs(q[live]),
+                                                                            axis=1))
+            live = live[moving & ~small]
+            if not len(live):
+                break
     return q
 
 
@@ -209,9 +227,11 @@ def _newton_upper(ev: _Enclosures, euclidean: bool, p: np.ndarray, w: np.ndarray
         unit = g / np.linalg.norm(g, axis=1, keepdims=True)
     unit = np.where(np.all(np.isfinite(unit), axis=1)[:, None], unit, 0.0)
     best = np.full(len(p), np.inf)
-    for rel in (1e-9, 1e-6, 1e-3):
-        best = np.minimum(best, _certified_upper(ev, euclidean, p, w, q, unit,
-                                                 np.full(len(p), rel * scale)))
+    todo = np.arange(len(p))
+    for rel in (1e-9, 1e-6, 1e-3):          # the shortest segment that certifies
+        best[todo] = _certified_upper(ev, euclidean, p[todo], w[todo], q[todo], unit[todo],
+                                      np.full(len(todo), rel * scale))
+        todo = todo[~np.isfinite(best[todo])]
     stalled = ~np.isfinite(best)
     best[stalled] = _ray_upper(ev, euclidean, p[stalled], w[stalled], q[stalled],
                                np.full(int(stalled.sum()), scale))
