@@ -53,7 +53,20 @@ __all__ = ["main", "ProgressBar", "load_model"]
 
 
 class ProgressBar:
-    """A one-line progress bar on a stream (stderr by default), for ``progress=``."""
+    """A one-line progress bar on a stream (stderr by default), for ``progress=``:
+    the share done, the time so far, and (from 1% and a second on) the time left
+    at the pace so far.
+
+    Examples
+    --------
+    >>> import io
+    >>> out = io.StringIO()
+    >>> bar = ProgressBar("distances", out, width=10)
+    >>> bar.start -= 30.0                      # as if it had run for 30 s
+    >>> bar(0.25)
+    >>> out.getvalue().split("]")[1].split()
+    ['25.0%', '30.0s,', 'about', '1m30s', 'left']
+    """
 
     def __init__(self, label: str = "voxelizing", stream: Any = None, width: int = 30):
         self.label, self.stream, self.width = label, stream or sys.stderr, width
@@ -68,13 +81,26 @@ class ProgressBar:
         filled = int(share * self.width)
         bar = "#" * filled + "-" * (self.width - filled)
         elapsed = time.perf_counter() - self.start
-        self.stream.write(f"\r{self.label} [{bar}] {share * 100:5.1f}% {elapsed:6.1f}s")
+        left = f", about {_duration(elapsed * (1.0 - share) / share)} left" \
+            if 0.01 <= share < 1.0 and elapsed >= 1.0 else ""
+        self.stream.write(f"\r{self.label} [{bar}] {share * 100:5.1f}% {elapsed:6.1f}s"
+                          f"{left:<22}")
         self.stream.flush()
 
     def close(self) -> None:
         self(1.0)
         self.stream.write("\n")
         self.stream.flush()
+
+
+def _duration(seconds: float) -> str:
+    """``42s``, ``3m05s``, ``1h02m``."""
+    seconds = int(round(seconds))
+    if seconds < 60:
+        return f"{seconds}s"
+    if seconds < 3600:
+        return f"{seconds // 60}m{seconds % 60:02d}s"
+    return f"{seconds // 3600}h{seconds % 3600 // 60:02d}m"
 
 
 class ModelError(Exception):
