@@ -12,7 +12,8 @@ __all__ = ["load_csg", "load_scene"]
 
 def load_csg(path: str, facets: str = "openscad") -> Any:
     """An OpenSCAD ``.csg`` file as a solid (OpenSCAD's facets, or true curves with
-    ``facets="true"``)."""
+    ``facets="true"``); a ``.scad`` file through the installed OpenSCAD
+    (:func:`csg.scad.export_csg`)."""
     return read_openscad(path, facets=facets)
 
 

@@ -69,6 +69,7 @@ from .projection import NotAMesh, projection as project
 from .text import text_polygon
 from .heightmap import heightmap_mesh
 from .openscad_parser import Node, OpenSCADError, OpenSCADWarning, parse
+from .scad import CSG_BYTES, export_csg
 from .planar import LinearExtrude, Polygon, Rectangle, RotateExtrude
 from implicitvox.triangles.inputs import MESH_SUFFIXES
 
@@ -94,12 +95,19 @@ IMPORT_SUFFIXES = (*MESH_SUFFIXES, ".dxf")
 
 
 def read_openscad(path_or_text: Any, facets: str = "openscad", base: Any = None) -> Solid:
-    """Read a ``.csg`` file (path) or its text into a solid.
+    """Read a ``.csg`` file (path) or its text into a solid; or a ``.scad`` file,
+    through the installed OpenSCAD.
 
     Parameters
     ----------
     path_or_text : str or os.PathLike
         A path to a ``.csg`` file, or ``.csg`` text (anything containing ``(``).
+        A path ending in ``.scad`` is first evaluated by OpenSCAD
+        (:func:`csg.scad.export_csg`: a temporary ``.csg``, OpenSCAD's warnings
+        passed on as :class:`OpenSCADWarning` s with their file and line, its
+        errors raised as :class:`OpenSCADError`, a time limit); the reader's
+        own messages on the export name it ``<path> (as .csg)``, with the line
+        and column of what ``openscad -o part.csg part.scad`` writes.
     facets : {"openscad", "true"}
         OpenSCAD's own facets (the solid OpenSCAD renders and exports), or the
         true curves they approximate.
@@ -113,6 +121,10 @@ def read_openscad(path_or_text: Any, facets: str = "openscad", base: Any = None)
     ------
     OpenSCADError
         Malformed or unsupported input (a ``ValueError`` with line and column).
+    csg.scad.OpenSCADNotFound
+        A ``.scad`` file, and no OpenSCAD to evaluate it.
+    TimeoutError
+        OpenSCAD took longer than :data:`csg.scad.OPENSCAD_SECONDS` on a ``.scad`` file.
     """
     if facets not in ("true", "openscad"):
         raise ValueError(f"facets must be 'true' or 'openscad', got {facets!r}")
@@ -120,9 +132,16 @@ def read_openscad(path_or_text: Any, facets: str = "openscad", base: Any = None)
                                                   and "(" not in path_or_text):
         path = os.fspath(path_or_text)
         if not os.path.isfile(path):
-            raise FileNotFoundError(f"no such .csg file: {path}")
-        with open(path, encoding="utf-8", errors="replace") as fh:
-            text, source = fh.read(), path
+            raise FileNotFoundError(f"no such file: {path}")
+        if path.lower().endswith(".scad"):
+            text, source = export_csg(path), f"{path} (as .csg)"
+            base = os.path.dirname(os.path.abspath(path)) if base is None else base
+        elif os.path.getsize(path) > CSG_BYTES:
+            raise OpenSCADError(f"the file is larger than {CSG_BYTES} bytes (csg.scad.CSG_BYTES)",
+                                1, None, path)
+        else:
+            with open(path, encoding="utf-8", errors="replace") as fh:
+                text, source = fh.read(), path
     elif isinstance(path_or_text, str):
         text, source = path_or_text, "<csg>"
     else:

@@ -62,11 +62,15 @@ def unescape(body: str) -> str:
 
 
 class OpenSCADError(ValueError):
-    """Malformed or unsupported ``.csg`` input, with its location."""
+    """Malformed or unsupported ``.csg`` input, with its location (``column`` is
+    ``None`` where the source names none: OpenSCAD's own errors on a ``.scad``
+    file give a line only)."""
 
-    def __init__(self, message: str, line: int, column: int, source: str = "<csg>"):
+    def __init__(self, message: str, line: int, column: Optional[int],
+                 source: str = "<csg>"):
         self.line, self.column, self.source = line, column, source
-        super().__init__(f"{source}:{line}:{column}: {message}")
+        where = f"{source}:{line}" if column is None else f"{source}:{line}:{column}"
+        super().__init__(f"{where}: {message}")
 
 
 class OpenSCADWarning(UserWarning):

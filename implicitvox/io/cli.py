@@ -8,13 +8,15 @@
     implicitvox voxelize bunny.obj --resolution 256 --interior --render bunny.png
     implicitvox voxelize bracket.csg --resolution 256 --out bracket.npz   # OpenSCAD's facets
     implicitvox voxelize bracket.csg --facets true --resolution 256      # true curves
+    implicitvox voxelize knob.scad --render knob.png      # through the installed OpenSCAD
     implicitvox mesh --example gear --tolerance 0.01 --out gear.stl --render gear.png
     implicitvox field --example gear --resolution 256 --band 4 --out gear-sdf.vti
     implicitvox field bunny.obj --norm linf --resolution 256 --check-suitability
 
 A model file is Python that defines ``shape`` (an expression or a shape);
 errors inside it are reported with the model's own file and line. OpenSCAD
-``.csg`` files and JSON scenes are read by ``csg`` (registered as loaders). A mesh
+``.csg`` files and JSON scenes are read by ``csg`` (registered as loaders), and
+``.scad`` files too when OpenSCAD is installed (it evaluates them). A mesh
 file (``.stl``, ``.ply``, ``.obj``, ``.vtk``, ``.vtp``) is voxelized exactly
 (:func:`implicitvox.voxelize_mesh`; ``--interior`` fills closed meshes).
 ``mesh`` triangulates a model within a guaranteed Hausdorff distance
@@ -33,6 +35,7 @@ import runpy
 import sys
 import time
 import traceback
+import warnings
 from typing import Any, Iterator, Optional, Sequence
 
 from .. import validate
@@ -130,7 +133,7 @@ def load_model(path: str, **options: Any) -> Any:
     ``.py`` files run as Python (they are the user's own code); the error of
     a failing model names the model's line. Other suffixes go to the loaders
     registered under the entry-point group ``implicitvox.loaders`` (``csg``
-    registers ``.csg`` and ``.json``); ``options`` are passed to them.
+    registers ``.csg``, ``.scad`` and ``.json``); ``options`` are passed to them.
     """
     if not os.path.isfile(path):
         raise ModelError(f"no such model file: {path}")
@@ -161,16 +164,18 @@ def _parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="implicitvox",
                                      description="Robust voxelization of implicit solids.",
                                      epilog="A .py model file is Python and is executed: run "
-                                            "only model files you trust. Every other format "
-                                            "(.csg, .json, meshes, voxel files) is read as "
-                                            "data.")
+                                            "only model files you trust. A .scad file is "
+                                            "evaluated by the installed OpenSCAD. Every other "
+                                            "format (.csg, .json, meshes, voxel files) is read "
+                                            "as data.")
     parser.add_argument("--debug", action="store_true",
                         help="show the traceback of an error (for bug reports)")
     sub = parser.add_subparsers(dest="command", required=True)
     sub.add_parser("examples", help="list the built-in example models")
     vox = sub.add_parser("voxelize", help="voxelize a model")
     vox.add_argument("model", nargs="?",
-                     help="a .py file that defines `shape`, or a mesh (.stl .ply .obj .vtk .vtp)")
+                     help="a .py file that defines `shape`, a .csg, .scad or .json model, or "
+                          "a mesh (.stl .ply .obj .vtk .vtp)")
     vox.add_argument("--example", help="a built-in example instead of a model file")
     size = vox.add_mutually_exclusive_group()
     size.add_argument("--resolution", type=int, help="voxels along the longest side (default 256)")
@@ -178,7 +183,8 @@ def _parser() -> argparse.ArgumentParser:
     vox.add_argument("--bounds", type=float, nargs=6, metavar=("X0", "Y0", "Z0", "X1", "Y1", "Z1"))
     vox.add_argument("--interior", action="store_true", help="also find interior octants")
     vox.add_argument("--facets", choices=["openscad", "true"], default="openscad",
-                     help=".csg models: OpenSCAD's own facets (default), or true curves")
+                     help=".csg and .scad models: OpenSCAD's own facets (default), or "
+                          "true curves")
     vox.add_argument("--normals", action="store_true", help="store normals")
     vox.add_argument("--mean-value", action="store_true",
                      help="tighter: mean value form on ambiguous octants (about 3x the time)")
@@ -199,7 +205,8 @@ def _parser() -> argparse.ArgumentParser:
                      help="print whether the solid is S_r-open and closed with r > sqrt(6) "
                           "voxels (Baerentzen's criterion) and the predicted error")
     fld = sub.add_parser("field", help="signed distances in a narrow band, with their error")
-    fld.add_argument("model", nargs="?", help="a .py, .csg or .json model, or a mesh")
+    fld.add_argument("model", nargs="?", help="a .py, .csg, .scad or .json model, or a "
+                                                  "mesh")
     fld.add_argument("--example", help="a built-in example instead of a model file")
     size = fld.add_mutually_exclusive_group()
     size.add_argument("--resolution", type=int, help="voxels along the longest side (default 256)")
@@ -211,7 +218,8 @@ def _parser() -> argparse.ArgumentParser:
     fld.add_argument("--tolerance", type=float, metavar="E",
                      help="error target of certified distances (default 1e-3 voxel)")
     fld.add_argument("--facets", choices=["openscad", "true"], default="openscad",
-                     help=".csg models: OpenSCAD's own facets (default), or true curves")
+                     help=".csg and .scad models: OpenSCAD's own facets (default), or "
+                          "true curves")
     fld.add_argument("--out", help="write .npz (lossless) or .vti")
     fld.add_argument("--render", metavar="PNG", help="render the 0-isosurface")
     fld.add_argument("--check-suitability", action="store_true",
@@ -221,8 +229,8 @@ def _parser() -> argparse.ArgumentParser:
     fld.add_argument("--quiet", action="store_true", help="no progress bar")
     msh = sub.add_parser("mesh", help="triangulate a model within a guaranteed Hausdorff "
                                       "distance")
-    msh.add_argument("model", nargs="?", help="a .py file that defines `shape`, or a .csg or "
-                                              ".json model")
+    msh.add_argument("model", nargs="?", help="a .py file that defines `shape`, or a .csg, "
+                                              ".scad or .json model")
     msh.add_argument("--example", help="a built-in example instead of a model file")
     size = msh.add_mutually_exclusive_group(required=True)
     size.add_argument("--tolerance", type=float, metavar="E",
@@ -231,7 +239,8 @@ def _parser() -> argparse.ArgumentParser:
                       help="cells along the longest side (the bound is sqrt(3) cells)")
     msh.add_argument("--bounds", type=float, nargs=6, metavar=("X0", "Y0", "Z0", "X1", "Y1", "Z1"))
     msh.add_argument("--facets", choices=["openscad", "true"], default="openscad",
-                     help=".csg models: OpenSCAD's own facets (default), or true curves")
+                     help=".csg and .scad models: OpenSCAD's own facets (default), or "
+                          "true curves")
     msh.add_argument("--refine", type=int, default=REFINE, metavar="K",
                      help=f"levels complex cells may be split below the largest (default {REFINE})")
     msh.add_argument("--no-prune", dest="prune", action="store_false",
@@ -421,6 +430,19 @@ def _voxelize(args: argparse.Namespace) -> int:
     return 0
 
 
+@contextlib.contextmanager
+def _warnings_as_lines(debug: bool) -> Iterator[None]:
+    """A warning as one line, ``implicitvox: warning: <message>`` (the message names
+    the model's file, line and column), not Python's two lines naming our source;
+    ``--debug`` keeps Python's."""
+    with warnings.catch_warnings():
+        if not debug:
+            def show(message: Any, category: type, *_: Any, **__: Any) -> None:
+                print(f"implicitvox: warning: {message}", file=sys.stderr)
+            warnings.showwarning = show
+        yield
+
+
 def main(argv: Optional[Sequence[str]] = None) -> int:
     """Entry point; returns the exit status: 0, 2 for bad input (one line on stderr,
     naming it), 1 for anything else (one line; ``--debug`` shows the traceback),
@@ -431,7 +453,8 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
             for name, (description, _) in EXAMPLES.items():
                 print(f"{name:<14}{description}")
             return 0
-        return {"mesh": _mesh, "field": _field, "voxelize": _voxelize}[args.command](args)
+        with _warnings_as_lines(args.debug):
+            return {"mesh": _mesh, "field": _field, "voxelize": _voxelize}[args.command](args)
     except (ModelError, ValueError, TypeError, MemoryError, OSError) as err:
         if args.debug:
             traceback.print_exc()
