@@ -263,9 +263,8 @@ class Solid:
         exact (its gradient is the normal) or no leaf has a mesh."""
         if self.expression_is_exact:
             return None
-        boundary = self.regularized_boundary
-        triangles = boundary.tris.v if boundary is not None else \
-            (_FACETS[-1](self) if _FACETS else None)
+        mesh = getattr(self.regularized_boundary, "tris", None)   # none where it is empty
+        triangles = mesh.v if mesh is not None else (_FACETS[-1](self) if _FACETS else None)
         if triangles is None or not len(triangles):
             return None
         return lambda points: nearest_triangle_normals(triangles, np.asarray(points, float))
@@ -288,9 +287,10 @@ class Solid:
         """The exact box test of the boundary of the regularized solid - the closed
         mesh of a tree of polytopes, with its booleans computed by Manifold
         (:func:`csg.tree_mesh.regularized_classifier`, registered by
-        :func:`register_regularizer`), which keeps no face shared inside the solid -
-        or None when the tree has no such mesh (a curved leaf, an open mesh) or it
-        is empty. Built once, on the first tie."""
+        :func:`register_regularizer`), which keeps no face shared inside the solid
+        (and a test no box meets where it is empty: parts that only touch) - or
+        None when the tree has no such mesh (a curved leaf, an open mesh). Built
+        once, on the first tie."""
         return None if _REGULARIZERS == [] else _REGULARIZERS[-1](self)
 
     def voxelize(self, resolution: Any = None, **options: Any) -> iv.Voxels:

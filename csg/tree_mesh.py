@@ -28,13 +28,15 @@ from typing import Optional
 
 import numpy as np
 
+from implicitvox.expr.shape import EMPTY
 from implicitvox.triangles.closed import mesh_volume
 
 from .protocol import NotAMesh, fold
 from .tree_classifier import MeshClassifier
 from .solid import Solid, register_facets, register_regularizer
 
-__all__ = ["tree_mesh", "leaf_mesh", "mesh_volume", "NotAMesh", "regularized_classifier"]
+__all__ = ["tree_mesh", "leaf_mesh", "mesh_volume", "NotAMesh", "regularized_classifier",
+           "EmptyBoundary"]
 
 def leaf_mesh(solid: Solid, matrix: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """The closed triangle mesh (vertices, faces) of a polytope leaf, moved by
@@ -99,16 +101,27 @@ def tree_mesh(solid: Solid, matrix: np.ndarray) -> tuple[np.ndarray, np.ndarray]
     return v, np.asarray(result.tri_verts, dtype=np.int64).reshape(-1, 3)
 
 
+class EmptyBoundary:
+    """The boundary of a regularized solid that is empty - parts that only touch, as
+    the intersection of two cubes sharing a face: no box meets it (OpenSCAD 2021.01
+    exports that face as a sheet, warning that the object "may not be a valid
+    2-manifold"; the regularized solid has none)."""
+
+    def classify(self, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+        """EMPTY for every box ``[lo, hi]``."""
+        return np.full(len(lo), EMPTY, dtype=np.int8)
+
+
 def regularized_classifier(solid: Solid):
     """The exact box test (:class:`~csg.tree_classifier.MeshClassifier`) of the boundary of
     the regularized ``solid``: its :func:`tree_mesh`, whose booleans keep no face
-    shared inside the solid; None where the tree has no mesh (a curved leaf, an
-    open mesh) or is empty."""
+    shared inside the solid (:class:`EmptyBoundary` where the mesh is empty); None
+    where the tree has no mesh (a curved leaf, an open mesh)."""
     try:
         v, f = tree_mesh(solid, np.eye(4))
     except (NotAMesh, ValueError):
         return None
-    return MeshClassifier(v, f) if len(f) else None
+    return MeshClassifier(v, f) if len(f) else EmptyBoundary()
 
 
 def leaf_triangles(solid: Solid) -> Optional[np.ndarray]:

@@ -130,6 +130,33 @@ def test_an_intersection_with_an_empty_extrusion_is_empty():
               "square(size = 5); }")
 
 
+TOUCHING = ("intersection() {\n  cube(size = 10);\n"
+            "  multmatrix([[1, 0, 0, 10], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]]) "
+            "cube(size = 10);\n}\n")
+TURNED = ("multmatrix([[0.866025, -0.5, 0, 0], [0.5, 0.866025, 0, 0], [0, 0, 1, 0], "
+          "[0, 0, 0, 1]]) {\n" + TOUCHING + "}\n")
+FAR_CUBE = "multmatrix([[1, 0, 0, 40], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]]) cube(size = 6);"
+
+
+@pytest.mark.parametrize("text", [TOUCHING, TURNED, TOUCHING + FAR_CUBE, TURNED + FAR_CUBE],
+                         ids=["alone", "turned", "beside-a-cube", "turned-beside-a-cube"])
+def test_cubes_that_only_touch_intersect_in_nothing(text):
+    """The intersection of two cubes sharing a face has no volume: no voxel, alone or
+    beside another part (it used to leave the shared face, a one-voxel layer, where
+    it stood alone). OpenSCAD 2021.01 exports that face as a sheet of volume 0,
+    warning that the object "may not be a valid 2-manifold and may need repair";
+    the regularized solid, which this voxelizes, has no surface there."""
+    solid = _read(text)
+    bounds = ((-10.0, -10.0, -10.0), (50.0, 30.0, 20.0))
+    vox = iv.voxelize(solid, 60, bounds=bounds, workers=1)
+    alone = iv.voxelize(_read(FAR_CUBE), 60, bounds=bounds, workers=1) \
+        if FAR_CUBE in text else None
+    if alone is None:
+        assert vox.count == 0
+    else:
+        assert alone.count > 0 and np.array_equal(vox.coords(), alone.coords())
+
+
 def test_a_hull_skips_an_empty_child_and_hulls_the_rest():
     text = ("hull() {\n  intersection() { cube(size = 1); multmatrix([[1, 0, 0, 5], [0, 1, 0, 0], "
             "[0, 0, 1, 0], [0, 0, 0, 1]]) cube(size = 1); }\n"

@@ -1,0 +1,13 @@
+// Constructs of issue 51, each checked against OpenSCAD 2021.01's own STL.
+// A 2D child of a 3D boolean is ignored (a warning), not an endless drill.
+difference() { cube(10); circle(r = 6); }
+// resize with auto: every auto axis takes the factor of the largest new size.
+translate([20, 0, 0]) resize([6, 0, 0], auto = [1, 1, 1]) cube(9);
+// An intersection with an empty extrusion is empty.
+translate([20, 20, 0]) intersection() { cube(10); linear_extrude(height = 0) square(5); }
+// A hull skips an empty child (here an empty intersection) and hulls the rest.
+translate([0, 20, 0]) hull() {
+    cube([1, 1, 1]);
+    translate([4, 0, 0]) cube([1, 1, 1]);
+    intersection() { cube(1); translate([5, 5, 5]) cube(1); }
+}
