@@ -67,6 +67,7 @@ from .dxf import read_dxf
 from .prism import Prism, bound_functions
 from .projection import NotAMesh, projection as project
 from .text import text_polygon
+from .tessellation import quad_diagonals
 from .heightmap import heightmap_mesh
 from .openscad_parser import Node, OpenSCADError, OpenSCADWarning, parse
 from .scad import CSG_BYTES, export_csg
@@ -168,6 +169,25 @@ def read_openscad(path_or_text: Any, facets: str = "openscad", base: Any = None)
                             source)
     bound_functions(solid)      # many prisms: their exact tests, not their functions
     return solid
+
+
+def _quad_triangles(v: np.ndarray, quads: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """A polyhedron's quad faces ``a, b, c, d`` (clockwise seen from outside) as the two
+    triangles OpenSCAD 2021.01 cuts them into (:func:`csg.tessellation.quad_diagonals`),
+    and the alternative faces of the quads whose diagonal is not known there (a
+    projection that crosses itself): their other diagonal's triangles and the first
+    pair reversed, which cancel in the winding number, so that either diagonal's
+    voxels are kept (:attr:`csg.primitives.Polyhedron.alternative_faces`)."""
+    if not len(quads):
+        return np.zeros((0, 3), dtype=np.int64), np.zeros((0, 3), dtype=np.int64)
+    a, b, c, d = quads.T
+    along_ac = np.stack([np.stack([a, c, b], 1), np.stack([a, d, c], 1)], 1)
+    along_bd = np.stack([np.stack([b, d, c], 1), np.stack([b, a, d], 1)], 1)
+    diagonal = quad_diagonals(v[quads])
+    chosen = np.where((diagonal == 1)[:, None, None], along_bd, along_ac)
+    unknown = diagonal == -1
+    alternatives = np.concatenate([along_bd[unknown], along_ac[unknown][:, :, ::-1]], axis=1)
+    return chosen.reshape(-1, 3), alternatives.reshape(-1, 3)
 
 
 def _holds_text(node: Node) -> bool:
@@ -421,7 +441,7 @@ class _Builder:
             raise self.error(node, "polyhedron: points must be a list of finite [x, y, z]")
         if not isinstance(faces, list) or not faces:
             return self.skip(node, "it has no faces")
-        tris = []
+        tris, quads = [], []
         for k, face in enumerate(faces):
             if not isinstance(face, list) or not all(isinstance(i, float) and math.isfinite(i)
                                                      for i in face):
@@ -432,9 +452,13 @@ class _Builder:
                                        f"indices into points (0..{len(v) - 1}): the "
                                        "polyhedron is invalid")
             idx = [int(i) for i in face]
-            # OpenSCAD lists faces clockwise seen from outside: fan them reversed
-            tris += [(idx[0], idx[j + 1], idx[j]) for j in range(1, len(idx) - 1)]
-        return Polyhedron(v, np.array(tris, dtype=np.int64))
+            if len(idx) == 4:
+                quads.append(idx)
+            else:     # clockwise seen from outside, as OpenSCAD lists them: fanned reversed
+                tris += [(idx[0], idx[j + 1], idx[j]) for j in range(1, len(idx) - 1)]
+        quad_tris, alternatives = _quad_triangles(v, np.array(quads, dtype=np.int64))
+        return Polyhedron(v, np.concatenate([np.array(tris, dtype=np.int64).reshape(-1, 3),
+                                             quad_tris]), alternatives)
 
     def _import(self, node: Node) -> Optional[Solid]:
         """A triangle mesh file, as OpenSCAD imports it: the same solid in both facet

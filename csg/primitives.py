@@ -528,7 +528,7 @@ class Polyhedron(Solid):
         return cls(read.array(node, path, "vertices", (None, 3)),
                    read.array(node, path, "faces", (None, 3), integer=True))
 
-    def __init__(self, vertices: Any, faces: Any = None):
+    def __init__(self, vertices: Any, faces: Any = None, alternative_faces: Any = None):
         mesh = vertices if faces is None else (vertices, faces)
         v, f = as_triangles(mesh)
         if not len(f):
@@ -536,7 +536,22 @@ class Polyhedron(Solid):
         used = np.zeros(len(v), dtype=bool)
         used[f.ravel()] = True
         self.vertices, self.faces = v, f
+        #: triangles that may be its surface as well (``(k, 3)`` indices, in pairs that
+        #: cancel in the winding number): the other triangulation of a bent face, whose
+        #: diagonal OpenSCAD's tessellator chooses (:meth:`csg.openscad` ``polyhedron``);
+        #: the exact test counts them as surface, nothing else sees them
+        self.alternative_faces = np.zeros((0, 3), dtype=np.int64) if alternative_faces is None \
+            else np.asarray(alternative_faces, dtype=np.int64).reshape(-1, 3)
+        if self.alternative_faces.size and (self.alternative_faces.min() < 0 or
+                                            self.alternative_faces.max() >= len(v)):
+            raise ValueError("alternative_faces index past the vertices")
         self._lo, self._hi = v[used].min(axis=0), v[used].max(axis=0)
+
+    def _surface_faces(self) -> np.ndarray:
+        """Its faces and its :attr:`alternative_faces`: every triangle that may be surface."""
+        if not len(self.alternative_faces):
+            return self.faces
+        return np.concatenate([self.faces, self.alternative_faces])
 
     @property
     def expr(self) -> Expr:
@@ -554,7 +569,7 @@ class Polyhedron(Solid):
         return self.vertices @ matrix[:3, :3].T + matrix[:3, 3]
 
     def world_linf(self, matrix: np.ndarray) -> linf.Primitive:
-        return linf.TriangleMesh(self._world_vertices(matrix), self.faces)
+        return linf.TriangleMesh(self._world_vertices(matrix), self._surface_faces())
 
     def polytope_vertices(self, convex: bool, pieces: Any) -> np.ndarray:
         """The vertices its faces use; with ``convex``, only of a convex mesh."""
@@ -570,7 +585,8 @@ class Polyhedron(Solid):
 
     def exact_leaf(self, matrix: np.ndarray) -> tuple[str, Any]:
         flip = np.linalg.det(matrix[:3, :3]) < 0      # mirrored: the winding sign flips
-        return ("mesh", MeshClassifier(self._world_vertices(matrix), self.faces, flip))
+        return ("mesh", MeshClassifier(self._world_vertices(matrix), self._surface_faces(),
+                                       flip))
 
     def __repr__(self) -> str:
         return f"Polyhedron({len(self.vertices)} vertices, {len(self.faces)} triangles)"
