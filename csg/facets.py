@@ -47,8 +47,8 @@ __all__ = ["fragments", "helix_slices", "conical_helix_slices", "diagonal_slices
            "MAX_FRAGMENTS", "MAX_SPHERE_POINTS"]
 
 GRID_FINE = 0.00000095367431640625
-#: side-quad diagonals whose squared lengths differ by at most this share are equal
-#: to OpenSCAD (:func:`extrusion_mesh`)
+#: side-quad diagonals are equal to OpenSCAD when their lengths differ by at most this
+#: share of their mean (``sgn_vdiff``'s ``ratio_threshold`` of 1e5: 10 ppm)
 DIAGONAL_TIE = 1e-5
 
 
@@ -255,9 +255,12 @@ def extrusion_mesh_outlines(pieces: list, height: float, twist: float, scale: np
     region's parts ``(outer, [holes])``, outer outlines counter-clockwise and holes
     clockwise (as Clipper returns them: :func:`csg.clipper2d.region_pieces`).
 
-    Each side quad between two layers is split along its shorter diagonal (within a
-    relative :data:`DIAGONAL_TIE`, a tie, split by the twist's direction: measured
-    against OpenSCAD 2021.01's STL); the caps are each part triangulated with its holes
+    Each side quad between two layers is split as OpenSCAD 2021.01's ``add_slice``
+    splits it: along the diagonal shorter in the plane (within :data:`DIAGONAL_TIE`
+    a tie, split by the twist's direction and whether the outline is a hole), except
+    in the top slice of an extrusion scaled to 0 along an axis, where the choice is
+    reversed (the shorter diagonal there would leave ears of no thickness) and the
+    top cap is left out (it has no area); the caps are each part triangulated with its holes
     (`mapbox_earcut <https://github.com/skogler/mapbox_earcut_python>`_, Mapbox's
     ear clipping for polygons with holes: a cap is planar, so any triangulation
     of it is the same surface). Nothing is cut by a boolean afterwards, so where
@@ -266,6 +269,8 @@ def extrusion_mesh_outlines(pieces: list, height: float, twist: float, scale: np
     """
     steps = np.arange(slices + 1) / slices
     sx, sy = 1 + (scale[0] - 1) * steps, 1 + (scale[1] - 1) * steps
+    # the slices whose upper layer is scaled to 0 along an axis (OpenSCAD's any_zero)
+    zero_top = (sx[1:] == 0) | (sy[1:] == 0)
     turns = [_cos_sin_degrees(-twist * t) for t in steps]
     c, s = np.array([t[0] for t in turns]), np.array([t[1] for t in turns])
     verts, faces = [], []
@@ -285,11 +290,14 @@ def extrusion_mesh_outlines(pieces: list, height: float, twist: float, scale: np
             j1 = (j + 1) % k
             a_j, a_j1 = i * k + j, i * k + j1
             b_j, b_j1 = (i + 1) * k + j, (i + 1) * k + j1
-            # the shorter diagonal; a tie (within DIAGONAL_TIE) by the twist's direction
-            d1 = np.sum((layer[a_j] - layer[b_j1]) ** 2, axis=-1)
-            d2 = np.sum((layer[a_j1] - layer[b_j]) ** 2, axis=-1)
-            tie = np.abs(d1 - d2) <= DIAGONAL_TIE * np.maximum(d1, d2)
-            first = np.where(tie, twist >= 0, d1 < d2)[..., None, None]
+            # OpenSCAD's add_slice: the diagonal shorter in the plane, a tie by the twist's
+            # direction and the outline's kind, reversed at a top scaled to 0 on an axis
+            l1 = np.hypot(*(layer[a_j] - layer[b_j1])[..., :2].transpose(2, 0, 1))
+            l2 = np.hypot(*(layer[a_j1] - layer[b_j])[..., :2].transpose(2, 0, 1))
+            tie = 2 * np.abs(l1 - l2) <= DIAGONAL_TIE * (l1 + l2)
+            flip = (ring is not rings[0]) != (twist <= 0)
+            first = np.where(tie, not flip, l1 < l2) != zero_top[:, None]
+            first = first[..., None, None]
             split1 = np.stack([np.stack([a_j, a_j1, b_j1], -1), np.stack([a_j, b_j1, b_j], -1)], -2)
             split2 = np.stack([np.stack([a_j, a_j1, b_j], -1), np.stack([a_j1, b_j1, b_j], -1)], -2)
             faces.append(base + np.where(first, split1, split2).reshape(-1, 3))

@@ -94,6 +94,15 @@ def _facet_tolerance(model) -> float:
             length, radius = _outline_size(node.children[0])
             k = max(1.0, *np.atleast_1d(a.get("scale", 1.0)))
             worst = max(worst, scale * k * (length * alpha / 4 + radius * (1 - math.cos(alpha / 2))))
+        if node.name == "linear_extrude":
+            # a scale unequal on the axes makes each side quad a bilinear patch, which
+            # its two triangles leave by a quarter of its twist vector's part off the
+            # patch: the unequal half of a slice's scale step dS times an edge p - q
+            step = 1.0 - np.broadcast_to(np.asarray(a.get("scale", 1.0), float), (2,))
+            if step[0] != step[1]:
+                length, _ = _outline_size(node.children[0])
+                worst = max(worst, scale * abs(step[0] - step[1]) / 2 / a.get("slices", 1.0)
+                            * length / 4)
         if r is not None:
             n = fragments(r, *res)
             cos_lat = 1.0

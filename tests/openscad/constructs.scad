@@ -11,3 +11,9 @@ translate([0, 20, 0]) hull() {
     translate([4, 0, 0]) cube([1, 1, 1]);
     intersection() { cube(1); translate([5, 5, 5]) cube(1); }
 }
+// An extrusion scaled to 0 along one axis: its top slice is split along the other
+// diagonal (OpenSCAD's add_slice), or the wedge would differ from OpenSCAD's.
+translate([40, 0, 0]) linear_extrude(height = 10, scale = [1, 0], slices = 1)
+    polygon([[10, 0], [0, 5], [0, -5]]);
+translate([40, 20, 0]) linear_extrude(height = 10, scale = [1, 0], slices = 2)
+    polygon([[10, 0], [0, 5], [0, -5]]);
