@@ -4,7 +4,7 @@ the closed mesh OpenSCAD 2021.01 builds from it (``SurfaceNode::createGeometry``
 * A ``.dat`` file holds rows of numbers separated by spaces or tabs; blank lines
   and lines starting with ``#`` are skipped; row ``i``, column ``j`` is the
   height at ``(j, i)``. A missing entry of a short row is 0, as OpenSCAD's
-  table gives it.
+  table gives it (and, as in OpenSCAD, it does not lower the bottom).
 * A PNG image (read with imageio, which scikit-image brings) gives each pixel
   the height ``100 / 255 · (0.2126 R + 0.7152 G + 0.0722 B)`` of its 8-bit
   channels, or ``100 / 255 · (1 − that sum)`` with ``invert`` (as OpenSCAD
@@ -49,11 +49,18 @@ def read_heights(path: Any, invert: bool = False) -> np.ndarray:
         The file holds a value that is not a number, or over :data:`MAX_SAMPLES`
         heights, or an image that cannot be decoded (naming the file).
     """
+    return _heights_and_lowest(path, invert)[0]
+
+
+def _heights_and_lowest(path: Any, invert: bool) -> tuple[np.ndarray, float]:
+    """:func:`read_heights`, and the lowest height the file gives (a short row's missing
+    entries are 0 in the table, but OpenSCAD's bottom comes from the given ones)."""
     name = os.fspath(path)
     with open(name, "rb") as stream:
         head = stream.read(8)
     if head == _PNG:
-        return _png_heights(name, invert)
+        heights = _png_heights(name, invert)
+        return heights, float(heights.min()) if heights.size else 0.0
     rows = []
     count = 0
     with open(name, encoding="utf-8", errors="replace") as stream:
@@ -74,7 +81,7 @@ def read_heights(path: Any, invert: bool = False) -> np.ndarray:
     table = np.zeros((len(rows), columns))
     for i, row in enumerate(rows):
         table[i, :len(row)] = row
-    return table
+    return table, min((min(r) for r in rows if r), default=0.0)
 
 
 def _png_heights(name: str, invert: bool) -> np.ndarray:
@@ -113,12 +120,12 @@ def heightmap_mesh(path: Any, center: bool = False, invert: bool = False
     ValueError
         As :func:`read_heights`, or a table smaller than 2 x 2 (no area).
     """
-    heights = read_heights(path, invert)
+    heights, lowest = _heights_and_lowest(path, invert)
     lines, columns = heights.shape if heights.size else (0, 0)
     if lines < 2 or columns < 2:
         raise ValueError(f"{os.fspath(path)}: {lines} x {columns} heights span no area "
                          "(at least 2 x 2)")
-    bottom = min(0.0, float(heights.min()) - 1)
+    bottom = min(0.0, lowest - 1)         # of the given heights, not a short row's zeros
     ox = -(columns - 1) / 2.0 if center else 0.0
     oy = -(lines - 1) / 2.0 if center else 0.0
     jj, ii = np.meshgrid(np.arange(columns, dtype=np.float64), np.arange(lines, dtype=np.float64))

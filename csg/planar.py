@@ -38,7 +38,12 @@ from .solid import Bounds, Solid, Union
 from .triangulate import triangulate
 
 __all__ = ["Circle", "Rectangle", "Polygon", "pieces_polygon", "linear_extrude",
-           "rotate_extrude", "LinearExtrude", "RotateExtrude"]
+           "rotate_extrude", "LinearExtrude", "RotateExtrude", "AXIS_SLACK"]
+
+#: a 2D shape of rotate_extrude crosses the axis when its bounds reach past x = 0 by
+#: more than this share of their reach on either side (bounds are rounded outward by
+#: far less: a shape touching the axis stays on one side)
+AXIS_SLACK = 1e-9
 
 
 class Shape2D(Solid):
@@ -581,8 +586,11 @@ class RotateExtrude(Solid):
         if not (0 < abs(self.angle) <= 360):
             raise ValueError(f"angle must be in (0, 360] degrees (or negative), got {angle!r}")
         b = shape.bounds
-        if b is not None and b[0][0] < 0 < b[1][0]:
-            raise ValueError("rotate_extrude: the 2D shape must lie on one side of the axis "
+        # beyond the bounds' outward rounding: a circle touching the axis (a horn torus,
+        # OpenSCAD's test model horn-torus.scad) has bounds a hair across it
+        slack = AXIS_SLACK * max(abs(b[0][0]), abs(b[1][0])) if b is not None else 0.0
+        if b is not None and b[0][0] < -slack and slack < b[1][0]:
+            raise ValueError("the 2D shape of rotate_extrude must lie on one side of the axis "
                              "(x >= 0); it crosses x = 0")
 
     @property

@@ -86,3 +86,13 @@ def test_surface_in_a_csg_file(tmp_path):
     assert solid.bounds == ((-0.5, -0.5, -1.0), (0.5, 0.5, 2.0))
     with pytest.warns(csg.OpenSCADWarning, match="surface: cannot open"):
         csg.read_openscad('surface(file = "gone.dat"); cube(1);', base=tmp_path, facets="true")
+
+
+def test_a_short_row_does_not_lower_the_bottom(tmp_path):
+    """OpenSCAD's test model issue1223: a last row of one height leaves the others 0,
+    and OpenSCAD's bottom is still min(0, lowest given height - 1) = 0, not -1."""
+    path = tmp_path / "short.dat"
+    path.write_text("9 6 7\n6 8 9\n5 3 2\n2\n")
+    v, _ = heightmap_mesh(path)
+    assert v[:, 2].min() == 0.0
+    assert read_heights(path)[3].tolist() == [2.0, 0.0, 0.0]

@@ -10,6 +10,7 @@ import pytest
 
 import csg
 import implicitvox as iv
+from tests.support.mesh_helpers import misses
 
 REST = "sphere(r = 1);"
 BOUNDS = ((-1.5,) * 3, (1.5,) * 3)
@@ -186,3 +187,17 @@ def test_a_circle_of_radius_0_is_skipped_and_its_extrusion_with_it():
                                                  r"positive; skipped, as OpenSCAD does"):
         solid = csg.read_openscad(text, facets="true")
     assert np.allclose(solid.bounds, ((-1,) * 3, (1,) * 3))
+
+
+def test_a_profile_touching_the_axis_is_revolved():
+    """OpenSCAD's test model horn-torus.scad: a circle touching the axis (its bounds
+    a rounding hair across x = 0) makes a horn torus, not an error."""
+    text = ("rotate_extrude(angle = 360, convexity = 2, $fn = 24) {\n"
+            "  multmatrix([[1, 0, 0, 1], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]]) {\n"
+            "    circle(r = 1, $fn = 24);\n  }\n}\n")
+    assert csg.read_openscad(text).bounds is not None          # OpenSCAD's facets
+    solid = csg.read_openscad(text, facets="true")
+    vox = iv.voxelize(solid, 32, workers=1)
+    u, v = np.random.default_rng(5).uniform(0, 2 * np.pi, (2, 500))
+    points = np.stack([(1 + np.cos(u)) * np.cos(v), (1 + np.cos(u)) * np.sin(v), np.sin(u)], 1)
+    assert misses(vox, points) == 0
