@@ -371,9 +371,11 @@ class _Builder:
             mat = np.array(m, dtype=np.float64)
         except (TypeError, ValueError):
             mat = None
-        if mat is None or mat.shape not in ((4, 4), (3, 4), (3, 3)) or \
-                not np.all(np.isfinite(mat)):
+        if mat is None or mat.shape not in ((4, 4), (3, 4), (3, 3)):
             raise self.error(node, f"multmatrix: expected a 4 x 4 matrix, got {m!r:.80}")
+        if not np.all(np.isfinite(mat)):
+            return self.skip(node, "the transform holds NaN or infinity: its children are "
+                                   "removed")
         if mat.shape == (3, 4):
             mat = np.vstack([mat, [0, 0, 0, 1]])
         body = self._group(node)
@@ -441,7 +443,7 @@ class _Builder:
             raise self.error(node, "polyhedron: points must be a list of finite [x, y, z]")
         if not isinstance(faces, list) or not faces:
             return self.skip(node, "it has no faces")
-        tris, quads = [], []
+        tris, quads, degenerate = [], [], 0
         for k, face in enumerate(faces):
             if not isinstance(face, list) or not all(isinstance(i, float) and math.isfinite(i)
                                                      for i in face):
@@ -451,11 +453,19 @@ class _Builder:
                 return self.skip(node, f"faces[{k}] {face!r:.60} does not list 3 or more "
                                        f"indices into points (0..{len(v) - 1}): the "
                                        "polyhedron is invalid")
-            idx = [int(i) for i in face]
+            # a corner repeated next to itself is one corner, as OpenSCAD cleans faces
+            idx = [int(i) for n, i in enumerate(face) if i != face[n - 1]] \
+                if len(set(face)) > 1 else []
+            if len(idx) < 3:
+                degenerate += 1
+                continue
             if len(idx) == 4:
                 quads.append(idx)
             else:     # clockwise seen from outside, as OpenSCAD lists them: fanned reversed
                 tris += [(idx[0], idx[j + 1], idx[j]) for j in range(1, len(idx) - 1)]
+        if degenerate == len(faces):
+            return self.skip(node, "every face repeats a corner next to itself (fewer than "
+                                   "3 corners): no surface")
         quad_tris, alternatives = _quad_triangles(v, np.array(quads, dtype=np.int64))
         return Polyhedron(v, np.concatenate([np.array(tris, dtype=np.int64).reshape(-1, 3),
                                              quad_tris]), alternatives)

@@ -140,6 +140,13 @@ def _children_cpu() -> float:
     return use.ru_utime + use.ru_stime
 
 
+def _has_facets(stl: str) -> bool:
+    """Whether OpenSCAD's (ASCII) STL export holds a facet: for a model whose faces all
+    collapse it writes an empty solid, and there is no 3D result."""
+    with open(stl, "rb") as stream:
+        return b"facet" in stream.read(1 << 16)
+
+
 def _cpu() -> float:
     """CPU seconds of this process and of its finished children (a pool's workers).
     OpenSCAD's timed exports run outside the intervals this measures."""
@@ -346,6 +353,8 @@ def main() -> None:
     for scad in models:
         name = str(scad.relative_to(root).with_suffix(""))
         info = _export(scad, args.timeout, root, cache)
+        if info.get("stl_ok") and not _has_facets(info["stl"]):
+            info = {**info, "stl_ok": False, "stl_error": "an STL without facets"}
         if not info.get("stl_ok"):
             rows.append([name, "no 3D result: " + info.get("stl_error", "?")[:70]] + ["-"] * 8)
             print(" | ".join(rows[-1]), flush=True)

@@ -24,6 +24,8 @@ BOUNDS = ((-1.5,) * 3, (1.5,) * 3)
     ("cylinder(h = 1, r1 = 0, r2 = 0, center = false);", "cylinder: both radii are 0"),
     ("multmatrix([[0, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]]) "
      "{ cube(size = [1, 1, 1]); }", "multmatrix: the transform is singular"),
+    ("multmatrix([[nan, nan, 0, 0], [nan, nan, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]]) "
+     "{ cube(size = [1, 1, 1]); }", "multmatrix: the transform holds NaN or infinity"),
     ("rotate_extrude(angle = 0, convexity = 2) { square(size = [1, 1]); }",
      "rotate_extrude: angle 0 sweeps no volume"),
     ("polyhedron(points = [[0, 0, 0], [1, 0, 0], [0, 1, 0]], faces = [[0, 1, 5]]);",
@@ -33,6 +35,9 @@ BOUNDS = ((-1.5,) * 3, (1.5,) * 3)
     # issue 51: the same rule for every primitive and extrusion
     ("linear_extrude(height = 0) square(size = [1, 1]);",
      "linear_extrude: height 0 is not positive"),
+    ("polyhedron(points = [[0, -4, 1], [0, -5, 1], [0, -5, 2], [0, -4, 0]], "
+     "faces = [[1, 2, 2, 1], [0, 0, 3, 3]]);",       # OpenSCAD's test model issue1325
+     "polyhedron: every face repeats a corner next to itself"),
     ("polyhedron(points = undef, faces = [[0, 1, 2]], convexity = 1);",
      "polyhedron: its points are undef"),
 ])
