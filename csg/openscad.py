@@ -72,6 +72,7 @@ from .heightmap import heightmap_mesh
 from .openscad_parser import Node, OpenSCADError, OpenSCADWarning, parse
 from .scad import CSG_BYTES, export_csg
 from .planar import LinearExtrude, Polygon, Rectangle, RotateExtrude
+from implicitvox.triangles.closed import is_closed_mesh
 from implicitvox.triangles.inputs import MESH_SUFFIXES
 
 from .polytopes import NotAPolytope, hull, minkowski, vertices
@@ -156,7 +157,8 @@ def read_openscad(path_or_text: Any, facets: str = "openscad", base: Any = None)
         base = os.path.dirname(os.path.abspath(source)) if source != "<csg>" else os.getcwd()
     builder = _Builder(source, FACET_MODES[facets], os.fspath(base))
     builder.build_from_leaves(nodes)
-    built = [(n, s) for n, s in ((n, builder.build(n)) for n in nodes) if s is not None]
+    built = builder.closed_operands([(n, s) for n, s in ((n, builder.build(n)) for n in nodes)
+                                     if s is not None])
     if not built:
         raise OpenSCADError("the file holds no geometry", 1, 1, source)
     solids = [s for _, s in built]
@@ -219,6 +221,9 @@ class _Builder:
     def __init__(self, source: str, facets: FacetMode, base: str = "."):
         self.source, self.facets, self.base = source, facets, base
         self._built: dict[int, tuple[Node, Optional[Solid]]] = {}
+        #: the solids that are meshes OpenSCAD could not make a CGAL Nef polyhedron of
+        #: (not closed), and their transforms: dropped from booleans (closed_operands)
+        self._open: set[int] = set()
 
     @functools.cached_property
     def faceted_twin(self) -> "_Builder":
@@ -323,10 +328,41 @@ class _Builder:
         return [s for s in (self.build(c) for c in node.children) if s is not None]
 
     def _group(self, node: Node) -> Optional[Solid]:
-        kids = self.children(node)
+        built = [(c, s) for c, s in ((c, self.build(c)) for c in node.children)
+                 if s is not None]
+        kids = [s for _, s in self.closed_operands(built)]
         if not kids:
             return None
         return kids[0] if len(kids) == 1 else Union(*kids)
+
+    def closed_operands(self, built: list) -> list:
+        """The operands ``(child node, solid)`` of a boolean of two or more that OpenSCAD
+        keeps: it makes each a CGAL Nef polyhedron, which a mesh that is not closed
+        cannot be ("The given mesh is not closed!"), and drops that one with an error;
+        so does this, with a warning. A lone mesh is no boolean: it stays (OpenSCAD
+        exports it as it is)."""
+        if len(built) < 2:
+            return built
+        kept = []
+        for child, solid in built:
+            if id(solid) in self._open:
+                self.skip(child, "its mesh is not closed, so OpenSCAD cannot take it into "
+                                 "a boolean (\"The given mesh is not closed!\")")
+            else:
+                kept.append((child, solid))
+        return kept
+
+    def _open_if(self, solid: Optional[Solid], body: Solid) -> Optional[Solid]:
+        """``solid`` (a transform of ``body``), remembered as open where ``body`` is."""
+        if solid is not None and id(body) in self._open:
+            self._open.add(id(solid))
+        return solid
+
+    def _mesh(self, solid: Polyhedron) -> Polyhedron:
+        """A polyhedron or imported mesh, remembered as open where it is not closed."""
+        if not is_closed_mesh(solid.vertices, solid.faces):
+            self._open.add(id(solid))
+        return solid
 
     _union = _render = _color = _group
 
@@ -355,14 +391,21 @@ class _Builder:
             return None
         built = [(c, s) for c, s in ((c, self.build(c)) for c in node.children[1:])
                  if s is not None]
-        rest = [s for _, s in self._one_dimension(node, [(node.children[0], first)] + built)][1:]
+        operands = self.closed_operands(self._one_dimension(node, [(node.children[0], first)]
+                                                            + built))
+        if not operands or operands[0][1] is not first:
+            return None                       # the first operand dropped: nothing is left
+        rest = [s for _, s in operands[1:]]
         return Difference(first, *rest) if rest else first
 
     def _intersection(self, node: Node) -> Optional[Solid]:
         built = [(c, self.build(c)) for c in node.children]
         if not built or any(s is None for _, s in built):
             return None                       # an empty operand empties the intersection
-        kids = [s for _, s in self._one_dimension(node, built)]
+        operands = self._one_dimension(node, built)
+        kids = [s for _, s in self.closed_operands(operands)]
+        if len(kids) < len(operands):
+            return None                       # a dropped operand empties it, as in OpenSCAD
         return kids[0] if len(kids) == 1 else Intersection(*kids)
 
     def _multmatrix(self, node: Node) -> Optional[Solid]:
@@ -391,7 +434,7 @@ class _Builder:
                 ** len(linear):
             return self.skip(node, "the transform is singular (a scale of 0): its children "
                                    "collapse to a plane, line or point")
-        return Transformed(body, mat)
+        return self._open_if(Transformed(body, mat), body)
 
     def _cube(self, node: Node) -> Optional[Solid]:
         size = self.vector(node, "size", 3, 1.0, 0)
@@ -467,8 +510,9 @@ class _Builder:
             return self.skip(node, "every face repeats a corner next to itself (fewer than "
                                    "3 corners): no surface")
         quad_tris, alternatives = _quad_triangles(v, np.array(quads, dtype=np.int64))
-        return Polyhedron(v, np.concatenate([np.array(tris, dtype=np.int64).reshape(-1, 3),
-                                             quad_tris]), alternatives)
+        return self._mesh(Polyhedron(v, np.concatenate([np.array(tris, dtype=np.int64)
+                                                        .reshape(-1, 3), quad_tris]),
+                                     alternatives))
 
     def _import(self, node: Node) -> Optional[Solid]:
         """A triangle mesh file, as OpenSCAD imports it: the same solid in both facet
@@ -487,7 +531,7 @@ class _Builder:
         if not os.path.isfile(path):
             return self.skip(node, f"cannot open {path!r}")
         if suffix != ".dxf":
-            return Polyhedron(path)
+            return self._mesh(Polyhedron(path))
         layer = self.arg(node, "layer", None)
         if layer is not None and not isinstance(layer, str):
             raise self.error(node, f"import: layer must be a string, got {layer!r:.60}")
@@ -771,4 +815,4 @@ class _Builder:
                 scale[axis] = automatic
         if np.all(scale == 1):
             return body
-        return Transformed(body, np.diag([*scale, 1.0]))
+        return self._open_if(Transformed(body, np.diag([*scale, 1.0])), body)

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["mesh_volume", "hull_mesh", "is_convex_mesh", "CONVEX_TOLERANCE"]
+__all__ = ["mesh_volume", "hull_mesh", "is_convex_mesh", "is_closed_mesh", "CONVEX_TOLERANCE"]
 
 #: a mesh is convex when its volume is its hull's within this share of the hull's
 CONVEX_TOLERANCE = 1e-9
@@ -22,6 +22,36 @@ def mesh_volume(vertices: np.ndarray, faces: np.ndarray) -> float:
     """The signed volume of a closed triangle mesh (positive when oriented outward)."""
     a, b, c = (vertices[faces[:, k]] for k in range(3))
     return float(np.einsum("ij,ij->i", a, np.cross(b, c)).sum() / 6.0)
+
+
+def is_closed_mesh(vertices: np.ndarray, faces: np.ndarray) -> bool:
+    """Whether a triangle mesh is closed and consistently oriented, as a halfedge
+    structure (CGAL's ``Polyhedron_3``) needs it: with vertices at equal coordinates
+    taken as one and collapsed triangles left out, every directed edge occurs once
+    and its reverse occurs too.
+
+    Examples
+    --------
+    >>> v = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]], float)
+    >>> tet = np.array([[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]])
+    >>> is_closed_mesh(v, tet), is_closed_mesh(v, tet[:3])
+    (True, False)
+    """
+    vertices = np.asarray(vertices, dtype=np.float64)
+    faces = np.asarray(faces, dtype=np.int64).reshape(-1, 3)
+    if not len(faces):
+        return False
+    _, same = np.unique(vertices, axis=0, return_inverse=True)
+    f = same.reshape(-1)[faces]
+    f = f[(f[:, 0] != f[:, 1]) & (f[:, 1] != f[:, 2]) & (f[:, 2] != f[:, 0])]
+    if not len(f):
+        return False
+    edges = np.concatenate([f[:, [0, 1]], f[:, [1, 2]], f[:, [2, 0]]])
+    n = int(same.max()) + 1
+    forward = edges[:, 0] * n + edges[:, 1]
+    unique = np.unique(forward)
+    return len(unique) == len(forward) and bool(np.isin(edges[:, 1] * n + edges[:, 0],
+                                                        unique).all())
 
 
 def hull_mesh(points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -206,3 +206,40 @@ def test_a_profile_touching_the_axis_is_revolved():
     u, v = np.random.default_rng(5).uniform(0, 2 * np.pi, (2, 500))
     points = np.stack([(1 + np.cos(u)) * np.cos(v), (1 + np.cos(u)) * np.sin(v), np.sin(u)], 1)
     assert misses(vox, points) == 0
+
+
+OPEN_TET = ("polyhedron(points = [[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]], "
+            "faces = [[0, 1, 2], [0, 3, 1], [0, 2, 3]]);")       # one face missing
+
+
+def test_an_open_mesh_is_dropped_from_a_boolean_and_kept_alone():
+    """OpenSCAD cannot make a CGAL Nef polyhedron of a mesh that is not closed: beside
+    another part it drops it ("The given mesh is not closed!"; its STL holds the cube
+    alone, checked with OpenSCAD 2021.01, as in its test model bugs/issue802); alone
+    it exports it as it is."""
+    moved = "multmatrix([[1, 0, 0, 3], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]]) " + OPEN_TET
+    with pytest.warns(csg.OpenSCADWarning, match=r"<csg>:2:1: multmatrix: its mesh is not "
+                                                 r"closed"):
+        solid = csg.read_openscad("cube(size = 0.5);\n" + moved)
+    assert solid.bounds == ((0.0, 0.0, 0.0), (0.5, 0.5, 0.5))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        alone = csg.read_openscad(OPEN_TET)
+    assert alone.bounds == ((0.0, 0.0, 0.0), (1.0, 1.0, 1.0))
+    # and in the booleans (each as OpenSCAD 2021.01 exports it): nothing left to cut
+    # from, nothing cut, nothing shared
+    with pytest.warns(csg.OpenSCADWarning, match="not closed"):
+        assert _read_raw("difference() { " + OPEN_TET + " cube(size = 0.5); }") is None
+    with pytest.warns(csg.OpenSCADWarning, match="not closed"):
+        cut = _read_raw("difference() { cube(size = 2); " + OPEN_TET + " }")
+    assert cut.bounds == ((0.0, 0.0, 0.0), (2.0, 2.0, 2.0)) and not cut.children
+    with pytest.warns(csg.OpenSCADWarning, match="not closed"):
+        assert _read_raw("intersection() { cube(size = 2); " + OPEN_TET + " }") is None
+
+
+def _read_raw(text: str):
+    try:
+        return csg.read_openscad(text)
+    except csg.OpenSCADError as err:
+        assert "holds no geometry" in str(err)
+        return None
