@@ -67,7 +67,7 @@ from .dxf import read_dxf
 from .prism import Prism, bound_functions
 from .projection import NotAMesh, projection as project
 from .text import text_polygon
-from .tessellation import quad_diagonals
+from .tessellation import openscad_vertex_ids, quad_diagonals
 from .heightmap import heightmap_mesh
 from .openscad_parser import Node, OpenSCADError, OpenSCADWarning, parse
 from .scad import CSG_BYTES, export_csg
@@ -173,11 +173,13 @@ def read_openscad(path_or_text: Any, facets: str = "openscad", base: Any = None)
     return solid
 
 
-def _quad_triangles(v: np.ndarray, quads: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def _quad_triangles(v: np.ndarray, quads: np.ndarray, corner_ids: np.ndarray
+                    ) -> tuple[np.ndarray, np.ndarray]:
     """A polyhedron's quad faces ``a, b, c, d`` (clockwise seen from outside) as the two
-    triangles OpenSCAD 2021.01 cuts them into (:func:`csg.tessellation.quad_diagonals`),
-    and the alternative faces of the quads whose diagonal is not known there (a
-    projection that crosses itself): their other diagonal's triangles and the first
+    triangles OpenSCAD 2021.01 cuts them into (:func:`csg.tessellation.quad_diagonals`,
+    with OpenSCAD's vertex numbers ``corner_ids``), and the alternative faces of the
+    quads whose diagonal is not known there (a degenerate projection): their other
+    diagonal's triangles and the first
     pair reversed, which cancel in the winding number, so that either diagonal's
     voxels are kept (:attr:`csg.primitives.Polyhedron.alternative_faces`)."""
     if not len(quads):
@@ -185,7 +187,7 @@ def _quad_triangles(v: np.ndarray, quads: np.ndarray) -> tuple[np.ndarray, np.nd
     a, b, c, d = quads.T
     along_ac = np.stack([np.stack([a, c, b], 1), np.stack([a, d, c], 1)], 1)
     along_bd = np.stack([np.stack([b, d, c], 1), np.stack([b, a, d], 1)], 1)
-    diagonal = quad_diagonals(v[quads])
+    diagonal = quad_diagonals(v[quads], corner_ids)
     chosen = np.where((diagonal == 1)[:, None, None], along_bd, along_ac)
     unknown = diagonal == -1
     alternatives = np.concatenate([along_bd[unknown], along_ac[unknown][:, :, ::-1]], axis=1)
@@ -486,7 +488,7 @@ class _Builder:
             raise self.error(node, "polyhedron: points must be a list of finite [x, y, z]")
         if not isinstance(faces, list) or not faces:
             return self.skip(node, "it has no faces")
-        tris, quads, degenerate = [], [], 0
+        tris, quads, quad_faces, degenerate = [], [], [], 0
         for k, face in enumerate(faces):
             if not isinstance(face, list) or not all(isinstance(i, float) and math.isfinite(i)
                                                      for i in face):
@@ -504,12 +506,15 @@ class _Builder:
                 continue
             if len(idx) == 4:
                 quads.append(idx)
+                quad_faces.append(k)
             else:     # clockwise seen from outside, as OpenSCAD lists them: fanned reversed
                 tris += [(idx[0], idx[j + 1], idx[j]) for j in range(1, len(idx) - 1)]
         if degenerate == len(faces):
             return self.skip(node, "every face repeats a corner next to itself (fewer than "
                                    "3 corners): no surface")
-        quad_tris, alternatives = _quad_triangles(v, np.array(quads, dtype=np.int64))
+        ids = openscad_vertex_ids(v, [[int(i) for i in face] for face in faces])
+        quad_ids = np.array([ids[k] for k in quad_faces], dtype=np.int64).reshape(-1, 4)
+        quad_tris, alternatives = _quad_triangles(v, np.array(quads, dtype=np.int64), quad_ids)
         return self._mesh(Polyhedron(v, np.concatenate([np.array(tris, dtype=np.int64)
                                                         .reshape(-1, 3), quad_tris]),
                                      alternatives))

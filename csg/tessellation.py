@@ -41,15 +41,17 @@ array([0], dtype=int8)
 """
 from __future__ import annotations
 
+from typing import Optional
+
 import numpy as np
 
-__all__ = ["quad_diagonals", "DELAUNAY_SLACK"]
+__all__ = ["quad_diagonals", "openscad_vertex_ids", "DELAUNAY_SLACK"]
 
 #: libtess2 flips a diagonal when the angles facing it sum to at least pi plus this
 DELAUNAY_SLACK = 0.01
 
 
-def quad_diagonals(quads: np.ndarray) -> np.ndarray:
+def quad_diagonals(quads: np.ndarray, corner_ids: Optional[np.ndarray] = None) -> np.ndarray:
     """The diagonal OpenSCAD 2021.01 takes across each quad face, as listed in a ``.csg``
     file's ``polyhedron(faces = ...)``.
 
@@ -57,12 +59,15 @@ def quad_diagonals(quads: np.ndarray) -> np.ndarray:
     ----------
     quads : (n, 4, 3) array
         Each face's corners in the file's order.
+    corner_ids : (n, 4) int array, optional
+        OpenSCAD's numbers of those corners (:func:`openscad_vertex_ids`), which
+        decide a bow tie's diagonal; without them a bow tie's is not known.
 
     Returns
     -------
     (n,) int8 array
         0: the diagonal from corner 0 to corner 2; 1: from corner 1 to corner 3;
-        -1: not known here (the projected quad crosses itself or is degenerate).
+        -1: not known here (a bow tie without ``corner_ids``, or a degenerate quad).
     """
     quads = np.asarray(quads, dtype=np.float64).reshape(-1, 4, 3)
     n = len(quads)
@@ -84,8 +89,9 @@ def quad_diagonals(quads: np.ndarray) -> np.ndarray:
     s64, t64 = s.astype(np.float64), t.astype(np.float64)
     turn = (s64 - s64[:, prv]) * (t64[:, nxt] - t64) - (t64 - t64[:, prv]) * (s64[:, nxt] - s64)
     positive, negative = (turn > 0).sum(axis=1), (turn < 0).sum(axis=1)
-    known = (positive + negative == 4) & (positive != 2) & np.isfinite(norm).all(axis=1) & \
-        (absn.max(axis=1) > 0)
+    proper = (positive + negative == 4) & np.isfinite(norm).all(axis=1) & (absn.max(axis=1) > 0)
+    dart = proper & ((positive == 1) | (positive == 3))
+    bow_tie = proper & (positive == 2)
     # lexicographic order in (s, t) (libtess2's VertLeq): the largest corner and the smallest
     ranked = np.lexsort((t64, s64), axis=1)
     largest, smallest = ranked[:, 3], ranked[:, 0]
@@ -97,11 +103,105 @@ def quad_diagonals(quads: np.ndarray) -> np.ndarray:
     off_a = np.where(diagonal == 0, 1, 0)
     total = _angle(s, t, off_a) + _angle(s, t, off_a + 2)
     diagonal = np.where(total >= np.pi + DELAUNAY_SLACK, 1 - diagonal, diagonal)
+    # a dart: the only diagonal inside it, through its reflex corner (no flip passes it)
+    odd_sign = np.where((positive == 1)[:, None], turn > 0, turn < 0)
+    diagonal = np.where(dart, np.argmax(odd_sign, axis=1) % 2, diagonal)
     # back to the file's order: corner k of the reversed quad is corner 3 - k, and
     # 3 - k has the parity of k + 1: the diagonal 0-2 there is 3-1 here
+    # one corner on the line through its neighbours: the quad is a triangle with a
+    # corner on an edge (libtess2 cuts through that corner) or with a spike that turns
+    # back at it (libtess2 keeps the triangle; the spike's corner is OpenSCAD's ear)
+    corner = np.argmax(turn == 0, axis=1)
+    back = ((s64[rows, corner] - s64[rows, (corner + 3) % 4]) *
+            (s64[rows, (corner + 1) % 4] - s64[rows, corner]) +
+            (t64[rows, corner] - t64[rows, (corner + 3) % 4]) *
+            (t64[rows, (corner + 1) % 4] - t64[rows, corner])) < 0
+    flat = np.isfinite(norm).all(axis=1) & (absn.max(axis=1) > 0) & \
+        ((turn == 0).sum(axis=1) == 1) & (back | (positive == 3) | (negative == 3))
+    diagonal = np.where(flat, np.where(back, (corner + 1) % 2, corner % 2), diagonal)
     out = (1 - diagonal).astype(np.int8)
-    out[~known] = -1
+    if corner_ids is not None and bow_tie.any():
+        ids = np.asarray(corner_ids, dtype=np.int64).reshape(-1, 4)[bow_tie]
+        out[bow_tie] = _bow_tie_diagonals(ids[:, ::-1])
+    else:
+        out[bow_tie] = -1
+    out[~proper & ~flat] = -1
     return out
+
+
+def openscad_vertex_ids(points: np.ndarray, faces: list) -> list:
+    """OpenSCAD's number of each corner of each face (``Reindexer<Vector3f>`` in
+    ``tessellate_faces``): points at equal single-precision coordinates share one,
+    numbered in order of first use over the faces in file order, each face's
+    corners in reverse (the order OpenSCAD's polygons hold them)."""
+    points = np.asarray(points, dtype=np.float64)
+    _, key = np.unique(points.astype(np.float32), axis=0, return_inverse=True)
+    key = key.reshape(-1)
+    sequence = np.concatenate([np.asarray(f, dtype=np.int64)[::-1] for f in faces]) \
+        if faces else np.zeros(0, dtype=np.int64)
+    keys = key[sequence]
+    first_keys, first_use = np.unique(keys, return_index=True)
+    number = np.empty(len(first_keys), dtype=np.int64)
+    number[np.argsort(first_use, kind="stable")] = np.arange(len(first_keys))
+    per_key = np.full(int(key.max()) + 1 if len(key) else 0, -1, dtype=np.int64)
+    per_key[first_keys] = number
+    return [per_key[key[np.asarray(f, dtype=np.int64)]] for f in faces]
+
+
+#: buckets of a small ``std::unordered_map`` in GCC 12's libstdc++ (its first allocation)
+_BUCKETS = 13
+
+
+def _bow_tie_diagonals(ids: np.ndarray) -> np.ndarray:
+    """The diagonal OpenSCAD takes across bow ties whose corners carry OpenSCAD's numbers
+    ``ids (n, 4)`` in its polygon order (the file's reversed), as 0 (its corners 0-2 in
+    that order... returned in the file's order) or 1.
+
+    libtess2 cuts a bow tie at its crossing point; OpenSCAD drops the triangles that
+    use that new point (``tessellatePolygonWithHoles``) and closes the loop that is
+    left from its ``EdgeDict`` (``triangulateLoops``): the ear at the first vertex of
+    an ``unordered_map<int, list<int>>`` filled in the order of an
+    ``unordered_map<pair<int, int>, int, boost::hash>`` of the edges. So the cut is
+    the diagonal between that vertex's neighbours; iteration orders follow
+    libstdc++ (13 buckets, a new bucket's node first, a node first in its bucket)
+    and Boost 1.74's pair hash, as Debian's build of OpenSCAD 2021.01 has them
+    (checked on 40 bow ties of OpenSCAD's own STL exports).
+    """
+    edges_from = ids
+    edges_to = np.roll(ids, -1, axis=1)
+    edge_order = _iteration_order(_boost_pair_hash(edges_from, edges_to))
+    v2e_keys = np.take_along_axis(edges_from, edge_order, axis=1)   # inserted in that order
+    first = np.take_along_axis(v2e_keys, _iteration_order(v2e_keys)[:, :1], axis=1)[:, 0]
+    corner = np.argmax(ids == first[:, None], axis=1)            # the ear's corner
+    # the ear at corner k cuts k - 1 to k + 1: the diagonal not through k; in the file's
+    # order (reversed) corner k is 3 - k, of the other parity
+    return (corner % 2).astype(np.int8)
+
+
+def _boost_pair_hash(first: np.ndarray, second: np.ndarray) -> np.ndarray:
+    """``boost::hash<std::pair<int, int>>`` of Boost 1.74 on a 64-bit ``size_t``."""
+    m = np.uint64(0xC6A4A7935BD1E995)
+    seed = np.zeros(first.shape, dtype=np.uint64)
+    for value in (first, second):
+        k = value.astype(np.int64).astype(np.uint64) * m
+        k ^= k >> np.uint64(47)
+        k *= m
+        seed ^= k
+        seed *= m
+        seed += np.uint64(0xE6546B64)
+    return seed
+
+
+def _iteration_order(hashes: np.ndarray) -> np.ndarray:
+    """For each row of distinct keys' hashes, inserted left to right into a fresh
+    ``std::unordered_map`` of libstdc++: the positions in iteration order (the bucket
+    first used last comes first; in a bucket, the node inserted last)."""
+    bucket = (hashes.astype(np.uint64) % np.uint64(_BUCKETS)).astype(np.int64)
+    k = hashes.shape[1]
+    position = np.arange(k)
+    same = bucket[:, :, None] == bucket[:, None, :]
+    opened = np.where(same, position[None, None, :], k).min(axis=2)   # the bucket's first use
+    return np.lexsort((-position[None, :].repeat(len(bucket), 0), -opened), axis=1)
 
 
 def _libtess_normal(q: np.ndarray) -> np.ndarray:

@@ -9,7 +9,7 @@ import numpy as np
 
 import csg
 import implicitvox as iv
-from csg.tessellation import quad_diagonals
+from csg.tessellation import openscad_vertex_ids, quad_diagonals
 from implicitvox.triangles.inputs import as_triangles
 from tests.support.mesh_helpers import misses
 
@@ -39,9 +39,12 @@ def test_every_diagonal_is_the_one_in_openscads_stl():
     bent = np.abs(np.einsum("ij,ij->i", corners[:, 1] - corners[:, 0],
                             np.cross(corners[:, 2] - corners[:, 0],
                                      corners[:, 3] - corners[:, 1]))) > 1e-6
-    assert bent.sum() >= 20                      # the fixture is worth its name
-    diagonal = quad_diagonals(corners)
+    assert bent.sum() >= 60                      # the fixture is worth its name
+    ids = np.array(openscad_vertex_ids(points, faces))[[len(q) == 4 for q in faces]]
+    diagonal = quad_diagonals(corners, ids)
     assert (diagonal >= 0).all()
+    # its bow ties are decided by OpenSCAD's vertex numbers: without, they are not known
+    assert (quad_diagonals(corners) == -1).sum() >= 5
     assert 5 <= (diagonal == 1).sum() <= len(quads) - 5   # both kinds of cut occur
     edges = _stl_edges(points)
     ends = np.where(diagonal[:, None] == 0, quads[:, [0, 2]], quads[:, [1, 3]])
@@ -52,7 +55,7 @@ def test_every_diagonal_is_the_one_in_openscads_stl():
 
 
 def test_the_bent_polyhedron_voxelizes_as_openscads_stl():
-    """Cut along the fan's diagonals instead, 4,506 of the STL's voxels at 128 were missed."""
+    """Cut along the fan's diagonals instead, thousands of the STL's voxels are missed."""
     solid = csg.read_openscad(FIXTURES / "bent.csg")
     stl = iv.voxelize_mesh(str(FIXTURES / "bent.stl"), 96, workers=1)
     vox = solid.voxelize(bounds=stl.bounds, voxel_size=stl.voxel_size, workers=1)
@@ -60,20 +63,22 @@ def test_the_bent_polyhedron_voxelizes_as_openscads_stl():
     assert vox.count <= 1.002 * stl.count
 
 
-def test_a_bow_tie_keeps_both_diagonals_as_surface():
-    # a bent quad whose libtess2 projection (along y, off its normal's normal) crosses
-    # itself: OpenSCAD's cut is not repeated, and both count as surface
-    quad = np.array([[8.7, 2.3, 0.6], [10.8, -0.3, 9.2], [13.2, 3.2, 9.6], [5.1, 6.4, 2.7]])
-    assert quad_diagonals(quad[None]).tolist() == [-1]
-    normal = np.cross(quad[2] - quad[0], quad[3] - quad[1])
-    apex = quad.mean(axis=0) - 0.5 * normal / np.linalg.norm(normal) * 6
-    points = np.concatenate([quad, apex[None]])
-    faces = [[0, 1, 2, 3], [1, 0, 4], [2, 1, 4], [3, 2, 4], [0, 3, 4]]
-    text = f"polyhedron(points = {points.tolist()}, faces = {faces});"
-    solid = csg.read_openscad(text)
+def test_a_quad_of_unknown_cut_keeps_both_diagonals_as_surface():
+    # OpenSCAD's test model issue964: face [2, 3, 6, 5] projects (along z, off
+    # libtess2's normal) with two corners on one point; its cut is not repeated here,
+    # and both count as surface
+    points = np.array([[0, 0, 0], [10, 0, 0], [10, 10, 0], [0, 10, 0], [0, -20, 20],
+                       [10, -20, 20], [10, -20, 30], [0, -20, 30]], dtype=float)
+    faces = [[0, 1, 2, 3], [4, 5, 6, 7], [1, 2, 5, 4], [2, 3, 6, 5], [3, 0, 6, 5],
+             [0, 1, 4, 7]]
+    ids = np.array(openscad_vertex_ids(points, faces))
+    # the others as OpenSCAD 2021.01's STL of issue964 cuts them (1-5, 3-6 and 0-4 through
+    # a spike at a corner, the planar ones either way)
+    assert quad_diagonals(points[np.array(faces)], ids).tolist() == [0, 1, 0, -1, 0, 0]
+    solid = csg.read_openscad(f"polyhedron(points = {points.tolist()}, faces = {faces});")
     assert len(solid.alternative_faces) == 4
-    lo, hi = points.min(axis=0) - 1, points.max(axis=0) + 1
-    vox = iv.voxelize(solid, 48, bounds=(tuple(lo), tuple(hi)), workers=1)
+    vox = iv.voxelize(solid, 48, workers=1)
+    quad = points[[2, 3, 6, 5]]
     for tri in [(0, 1, 2), (0, 2, 3), (0, 1, 3), (1, 2, 3)]:     # either cut of the quad
         w = np.random.default_rng(sum(tri)).dirichlet(np.ones(3), 300)
         assert misses(vox, w @ quad[list(tri)]) == 0, tri
