@@ -24,13 +24,20 @@ repeats libtess2's steps for one quad, in single precision as libtess2 computes
 4. the Delaunay refinement (``tessMeshRefineDelaunay``): the diagonal flips when
    the two angles facing it sum to at least pi + 0.01 (``tesedgeIsLocallyDelaunay``).
 
-Where the projected quad crosses itself (a bow tie: libtess2 inserts the
-crossing point, OpenSCAD drops the triangles that use it and closes the hole
-from an unordered map), the choice is not repeated here: :func:`quad_diagonals`
-says ``-1`` and the caller keeps both diagonals as surface. Checked against
-OpenSCAD 2021.01's own STL exports: every convex and every dart-shaped
-projection of 1,281 random bent quads (``tests/csg/test_tessellation.py`` keeps a
-sample), and every face of OpenSCAD's test model ``issue1061.scad``.
+A projection that is not convex is handled as libtess2 and OpenSCAD do: a dart
+(one reflex corner) is cut through that corner; a bow tie (it crosses itself:
+libtess2 inserts the crossing point, OpenSCAD drops the triangles that use it and
+closes the loop that is left from hash maps) where that loop closing cuts, which
+needs OpenSCAD's numbers of the corners (:func:`openscad_vertex_ids`); a quad
+with one corner on the line through its neighbours as a triangle with a corner on
+an edge (cut through it) or with a spike (the spike's corner is the ear). A quad
+whose projection is degenerate otherwise (two corners on one point) is not
+known: :func:`quad_diagonals` says ``-1`` and the caller keeps both diagonals as
+surface. Checked against OpenSCAD 2021.01's own STL exports: every diagonal of the
+3,325 bent faces of 560 randomly bent boxes (bow ties and darts among them), and of
+OpenSCAD's test models
+``issue1061.scad``, ``issue964b.scad`` and ``issue964.scad`` (``tests/openscad/bent.scad``
+and ``tests/csg/test_tessellation.py`` keep a sample).
 
 Examples
 --------
