@@ -31,7 +31,7 @@ csg.protocol.NotAPolytope: a Sphere is curved: its hull or Minkowski sum is no p
 """
 from __future__ import annotations
 
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 
@@ -41,6 +41,7 @@ from .primitives import ConvexPolyhedron, Polyhedron
 from .protocol import NotAMesh, NotAPolytope, NotFlat, fold
 from .solid import Solid, Union
 from .tree_mesh import tree_mesh
+from implicitvox.triangles.closed import is_convex_mesh
 
 __all__ = ["hull", "minkowski", "vertices", "convex_pieces", "convex_solid", "NotAPolytope",
            "MAX_PLANES", "MAX_PIECES", "MAX_SUMS"]
@@ -78,26 +79,69 @@ def convex_pieces(solid: Solid, convex: bool = True) -> list[np.ndarray]:
     return _pieces(solid, np.eye(4), convex)
 
 
-def _pieces(solid: Solid, matrix: np.ndarray, convex: bool) -> list[np.ndarray]:
+class MeshPiece(NamedTuple):
+    """A piece of a Minkowski operand that is not convex: its closed mesh."""
+    vertices: np.ndarray
+    faces: np.ndarray
+
+
+def _pieces(solid: Solid, matrix: np.ndarray, convex: bool, meshes: bool = False) -> list:
     """The tree walked (:func:`csg.protocol.fold`) through its unions and transforms:
     each leaf's :meth:`~csg.solid.Solid.polytope_vertices`, a difference's or
-    intersection's result (:func:`_boolean_vertices`), moved."""
-    def leaf(node: Solid, moved: np.ndarray) -> list[np.ndarray]:
+    intersection's result (:func:`_boolean_vertices`), moved. With ``meshes`` (and
+    ``convex``), a 3D piece that is not convex is its closed mesh (a
+    :class:`MeshPiece`: a difference's or intersection's by Manifold, a
+    polyhedron's own) instead of an error."""
+    def leaf(node: Solid, moved: np.ndarray) -> list:
         if node.operation in ("difference", "intersection"):
-            if convex:
+            if convex and not (meshes and node.dim == 3):
                 name = type(node).__name__.lower()
                 raise NotAPolytope(f"a {name} in a Minkowski sum (its result is not convex "
                                    "in general, and its convex decomposition is not built: "
                                    "split it into convex parts)")
+            if convex:
+                v, f = _boolean_mesh(node)
+                return [_moved_piece(v, f, moved)]
             points = _boolean_vertices(node)
         else:
-            points = node.polytope_vertices(convex, convex_pieces)
+            try:
+                points = node.polytope_vertices(convex, convex_pieces)
+            except NotAPolytope as err:
+                if not (convex and meshes and node.dim == 3) or err.curved or err.empty:
+                    raise
+                try:
+                    v, f = node.closed_mesh()
+                except NotAMesh:
+                    raise err from None
+                return [_moved_piece(np.asarray(v, float), np.asarray(f, np.int64), moved)]
         if node.dim == 2:
             return [points[:, :2] @ moved[:2, :2].T + moved[:2, 3]]
         return [points @ moved[:3, :3].T + moved[:3, 3]]
 
     return fold(solid, leaf, lambda operation, parts: [p for part in parts for p in part],
                 matrix, booleans=("union",))
+
+
+def _moved_piece(v: np.ndarray, f: np.ndarray, moved: np.ndarray):
+    """A 3D mesh, moved: its vertices if it is convex (a convex piece), else a
+    :class:`MeshPiece`."""
+    v = v @ moved[:3, :3].T + moved[:3, 3]
+    if np.linalg.det(moved[:3, :3]) < 0:
+        f = f[:, ::-1]                       # mirrored: keep the faces outward
+    used = np.unique(f.ravel())
+    return v[used] if is_convex_mesh(v, f) else MeshPiece(v, f)
+
+
+def _boolean_mesh(solid: Solid) -> tuple[np.ndarray, np.ndarray]:
+    """The closed mesh of a 3D difference's or intersection's result (Manifold)."""
+    try:
+        v, f = tree_mesh(solid, np.eye(4))
+    except NotAMesh as err:
+        raise NotAPolytope(str(err), curved=err.curved) from None
+    if not len(f):
+        raise NotAPolytope(f"the {type(solid).__name__.lower()} is empty: no vertices",
+                           empty=True)
+    return v, f
 
 
 def _boolean_vertices(solid: Solid) -> np.ndarray:
@@ -182,30 +226,105 @@ def hull(*solids: Solid) -> Solid:
 
 
 def minkowski(*solids: Solid) -> Solid:
-    """The Minkowski sum of ``solids`` (unions of convex polytopes, all 2D or all
-    3D), exact: per combination of convex pieces, the hull of the pairwise sums
-    of their vertices; the union of those (OpenSCAD's ``minkowski()``).
+    """The Minkowski sum of ``solids`` (polytope trees, all 2D or all 3D), exact: per
+    combination of convex pieces, the hull of the pairwise sums of their vertices;
+    the union of those (OpenSCAD's ``minkowski()``).
+
+    A 3D piece that is not convex (a difference, a non-convex polyhedron) needs no
+    convex decomposition: for a closed mesh ``M`` and a convex ``C`` holding a
+    point ``c``, ``M ⊕ C = (M + c) ∪ ⋃ (T ⊕ C)`` over ``M``'s triangles ``T``
+    (a point ``m + c'`` of the sum off ``M + c`` is reached from ``m + c`` by
+    moving along ``c' - c``, which leaves ``M`` through a triangle while the rest
+    of the move stays in ``C``), each ``T ⊕ C`` the hull of ``3 |C|`` sums; for two
+    meshes, ``M ⊕ N = ⋃ (N + t) ∪ ⋃ (M + s) ∪ ⋃ (T ⊕ S)`` over their triangles
+    ``T ∋ t`` and ``S ∋ s``. The same point set as OpenSCAD's union over the convex
+    parts of its decomposition (CGAL's ``convex_decomposition_3``), whatever those
+    parts are. A 2D piece must be convex.
 
     Raises
     ------
     NotAPolytope
-        An operand is not a union of convex polytopes (:func:`convex_pieces`).
+        An operand has a curved piece, or a 2D piece that is not convex.
     ValueError
-        The sum would have more than :data:`MAX_PIECES` convex pieces or
+        The sum would have more than :data:`MAX_PIECES` pieces or
         :data:`MAX_SUMS` vertex sums.
     """
     _same_dim(solids, "minkowski")
-    sums = convex_pieces(solids[0])
+    sums = _pieces(solids[0], np.eye(4), True, meshes=True)
     for solid in solids[1:]:
-        pieces = convex_pieces(solid)
-        if len(sums) * len(pieces) > MAX_PIECES:
-            raise ValueError(f"minkowski: {len(sums) * len(pieces):,} convex pieces, over "
-                             f"the limit of {MAX_PIECES:,} (csg.polytopes.MAX_PIECES)")
-        count = sum(len(a) for a in sums) * sum(len(b) for b in pieces)
-        if count > MAX_SUMS:
-            raise ValueError(f"minkowski: {count:,} vertex sums, over the limit of "
-                             f"{MAX_SUMS:,} (csg.polytopes.MAX_SUMS)")
-        sums = [(a[:, None, :] + b[None, :, :]).reshape(-1, a.shape[1])
-                for a in sums for b in pieces]
-    parts = [convex_solid(p) for p in sums]
-    return parts[0] if len(parts) == 1 else Union(*parts)
+        pieces = _pieces(solid, np.eye(4), True, meshes=True)
+        sums = _sum_pairs(sums, pieces)
+    parts = [Polyhedron(p.vertices, p.faces) if isinstance(p, MeshPiece) else _hull_or_none(p)
+             for p in sums]
+    parts = [p for p in parts if p is not None]
+    if not parts:
+        raise ValueError("minkowski: the sum spans no volume")
+    if len(parts) == 1:
+        return parts[0]
+    if not any(isinstance(p, MeshPiece) for p in sums):
+        return Union(*parts)
+    # a sum through a mesh is many overlapping pieces (one per triangle): their union's
+    # boundary, computed once by Manifold as OpenSCAD computes it by CGAL, is one closed
+    # mesh, far cheaper to classify than the pieces' overlaps
+    try:
+        v, f = tree_mesh(Union(*parts), np.eye(4))
+    except NotAMesh:          # a mesh Manifold refuses (not manifold): the pieces' union
+        return Union(*parts)
+    if not len(f):
+        raise ValueError("minkowski: the sum spans no volume")
+    return Polyhedron(v, f)
+
+
+def _sum_pairs(first: list, second: list) -> list:
+    """The pieces of the sum of two operands' pieces (convex vertex sets and
+    :class:`MeshPiece` s): see :func:`minkowski`; bounded by :data:`MAX_PIECES` and
+    :data:`MAX_SUMS` before anything is summed."""
+    def size(p) -> tuple[int, int]:          # (pieces it makes per convex partner, points)
+        return (len(p.faces), 3 * len(p.faces)) if isinstance(p, MeshPiece) else (1, len(p))
+    pieces = sum(size(a)[0] * size(b)[0] + 2 for a in first for b in second)
+    if pieces > MAX_PIECES:
+        raise ValueError(f"minkowski: {pieces:,} pieces, over the limit of {MAX_PIECES:,} "
+                         "(csg.polytopes.MAX_PIECES)")
+    count = sum(size(a)[1] for a in first) * sum(size(b)[1] for b in second)
+    if count > MAX_SUMS:
+        raise ValueError(f"minkowski: {count:,} vertex sums, over the limit of "
+                         f"{MAX_SUMS:,} (csg.polytopes.MAX_SUMS)")
+    out: list = []
+    for a in first:
+        for b in second:
+            out += _sum_pair(a, b)
+    return out
+
+
+def _sum_pair(a, b) -> list:
+    """The pieces of ``a ⊕ b`` for two pieces (see :func:`minkowski`)."""
+    a_mesh, b_mesh = isinstance(a, MeshPiece), isinstance(b, MeshPiece)
+    if not a_mesh and not b_mesh:
+        return [(a[:, None, :] + b[None, :, :]).reshape(-1, a.shape[1])]
+    if a_mesh and not b_mesh:
+        return _mesh_plus_convex(a, b)
+    if b_mesh and not a_mesh:
+        return _mesh_plus_convex(b, a)
+    out = [MeshPiece(b.vertices + t, b.faces) for t in np.unique(a.vertices[a.faces[:, 0]],
+                                                                   axis=0)]
+    out += [MeshPiece(a.vertices + s, a.faces) for s in np.unique(b.vertices[b.faces[:, 0]],
+                                                                   axis=0)]
+    ta, tb = a.vertices[a.faces], b.vertices[b.faces]                # (p, 3, 3), (q, 3, 3)
+    sums = ta[:, None, :, None, :] + tb[None, :, None, :, :]          # (p, q, 3, 3, 3)
+    return out + list(sums.reshape(-1, 9, 3))
+
+
+def _mesh_plus_convex(mesh: MeshPiece, convex: np.ndarray) -> list:
+    """``M ⊕ C = (M + c) ∪ ⋃ (T ⊕ C)`` (see :func:`minkowski`)."""
+    triangles = mesh.vertices[mesh.faces]                               # (t, 3, 3)
+    sums = (triangles[:, :, None, :] + convex[None, None, :, :]).reshape(len(triangles), -1, 3)
+    return [MeshPiece(mesh.vertices + convex[0], mesh.faces)] + list(sums)
+
+
+def _hull_or_none(points: np.ndarray):
+    """:func:`convex_solid` of ``points``, or None where they span no volume (two
+    parallel triangles' sums: a flat piece adds nothing to a solid)."""
+    try:
+        return convex_solid(points)
+    except ValueError:
+        return None

@@ -12,6 +12,7 @@ import csg
 import implicitvox as iv
 from csg import (Box, Circle, Cylinder, NotAPolytope, Polygon, Polyhedron, Rectangle, Sphere,
                  hull, linear_extrude, minkowski, read_openscad)
+from csg.facets import extrusion_mesh_outlines
 from csg.polytopes import MAX_PIECES, convex_pieces, vertices
 
 
@@ -95,7 +96,7 @@ def test_what_is_no_polytope_is_refused_saying_why():
         hull(Sphere(1), Box((1, 1, 1)))
     assert err.value.curved
     with pytest.raises(NotAPolytope, match="difference in a Minkowski sum") as err:
-        minkowski(Box((2, 2, 2)) - Box((1, 1, 1)), Box((1, 1, 1)))
+        minkowski(Rectangle((2, 2)) - Rectangle((1, 1)), Rectangle((1, 1)))
     assert not err.value.curved
     with pytest.raises(NotAPolytope, match="Cylinder is curved"):
         minkowski(Box((1, 1, 1)), Cylinder(h=1, r=1))
@@ -116,16 +117,34 @@ def test_minkowski_pieces_are_bounded():
     assert 101 * 101 > MAX_PIECES
 
 
-def test_non_convex_polyhedron_in_a_sum_is_refused():
-    # an L-shaped prism as a closed mesh (from the extrusion of an L polygon)
+BOUNDS = ((-0.513, -0.513, -0.513), (3.487, 3.487, 3.487))     # no face on a voxel face
+
+
+def _same_voxels(a, b):
+    va, vb = (iv.voxelize(x, 40, bounds=BOUNDS, workers=1) for x in (a, b))
+    assert va.count > 0 and np.array_equal(va.coords(), vb.coords())
+
+
+def test_a_sum_with_pieces_that_are_not_convex_is_exact():
+    """``M ⊕ C = (M + c) ∪ ⋃ (T ⊕ C)``: a cube less a corner (a difference), an L-shaped
+    prism (a non-convex polyhedron) and two such together, summed, voxelize as the
+    sums of their convex parts (unions of boxes), which the sum distributes over."""
+    notched = Box((2, 2, 2)) - Box((1, 1, 1))
+    parts = [Box((1, 2, 2)).translate((1, 0, 0)), Box((1, 1, 2)).translate((0, 1, 0)),
+             Box((1, 1, 1)).translate((0, 0, 1))]
+    unit = Box((1, 1, 1), center=True)
+    _same_voxels(minkowski(notched, unit), minkowski(csg.Union(*parts), unit))
     ell = Polygon([[0, 0], [3, 0], [3, 1], [1, 1], [1, 3], [0, 3]])
-    import pyvista as pv
-    mesh = pv.PolyData(np.column_stack([ell.points, np.zeros(6)]),
-                       np.hstack([[6], np.arange(6)])).extrude((0, 0, 1), capping=True)
-    mesh = mesh.triangulate().clean()
-    poly = Polyhedron(mesh)
-    with pytest.raises(NotAPolytope, match="non-convex Polyhedron"):
-        minkowski(poly, Box((1, 1, 1)))
+    v, f = extrusion_mesh_outlines([(ell.points, [])], 1.0, 0.0, np.ones(2), 1, 0.0)
+    poly = Polyhedron(v, f)
+    ell_boxes = csg.Union(Box((3, 1, 1)), Box((1, 3, 1)))
+    small = Box((0.5, 0.25, 0.5), center=True)
+    _same_voxels(minkowski(poly, small), minkowski(ell_boxes, small))
+    _same_voxels(minkowski(small, poly), minkowski(ell_boxes, small))
+    # two meshes: M ⊕ N = ⋃ (N + t) ∪ ⋃ (M + s) ∪ ⋃ (T ⊕ S)
+    tiny = Polyhedron(0.2 * np.asarray(v), f)
+    tiny_boxes = csg.Union(Box((0.6, 0.2, 0.2)), Box((0.2, 0.6, 0.2)))
+    _same_voxels(minkowski(poly, tiny), minkowski(ell_boxes, tiny_boxes))
     assert hull(poly, Box((1, 1, 1))).bounds[1][0] == pytest.approx(3.0)
 
 

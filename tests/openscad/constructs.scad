@@ -17,3 +17,20 @@ translate([40, 0, 0]) linear_extrude(height = 10, scale = [1, 0], slices = 1)
     polygon([[10, 0], [0, 5], [0, -5]]);
 translate([40, 20, 0]) linear_extrude(height = 10, scale = [1, 0], slices = 2)
     polygon([[10, 0], [0, 5], [0, -5]]);
+// Minkowski sums of pieces that are not convex: a difference (a tube with a notch)
+// and a non-convex polyhedron (a box with a dent in its top), each with a box.
+translate([0, 40, 0]) minkowski() {
+    difference() {
+        cube(10);
+        translate([3, 3, -1]) cube([4, 4, 12]);
+        translate([-1, 4, 6]) cube([12, 2, 5]);
+    }
+    cube(1, center = true);
+}
+translate([20, 40, 0]) minkowski() {
+    polyhedron(points = [[0, 10, 10], [10, 10, 10], [10, 0, 10], [0, 0, 10], [0, 0, 0],
+                         [10, 0, 0], [10, 10, 0], [0, 10, 0], [5, 5, 4]],
+               faces = [[4, 5, 6, 7], [3, 2, 5, 4], [2, 1, 6, 5], [1, 0, 7, 6], [0, 3, 4, 7],
+                        [0, 1, 8], [1, 2, 8], [2, 3, 8], [3, 0, 8]]);
+    rotate([0, 0, 30]) cube([1, 2, 1], center = true);
+}
