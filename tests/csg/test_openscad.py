@@ -19,6 +19,7 @@ from csg.openscad import SUPPORTED
 from csg.openscad_parser import OpenSCADError, parse
 from implicitvox.triangles.inputs import as_triangles
 from tests.support.clip_oracle import triangle_meets_box
+from tests.support.facet_tolerance import facet_tolerance
 from tests.support.mesh_helpers import sample_surface
 
 FIXTURES = Path(__file__).resolve().parents[1] / "openscad"
@@ -69,72 +70,10 @@ def test_facets_contain_openscads_own_voxels(model):
 
 
 def _facet_tolerance(model) -> float:
-    """The largest chordal deviation of the model's curves (sagitta r (1 - cos(pi / n))),
-    times the largest scale of the transforms above them."""
-    worst = 0.0
-
-    def visit(node, scale):
-        nonlocal worst
-        a = node.args
-        if node.name == "multmatrix":
-            m = a.get("m", node.positional[0] if node.positional else None)
-            scale = scale * float(np.linalg.norm(np.array(m)[:3, :3], 2))
-        res = (a.get("$fn", 0.0), a.get("$fs", 2.0), a.get("$fa", 12.0))
-        r = None
-        if node.name in ("sphere", "circle"):
-            r = a.get("r", 1.0)
-        elif node.name == "cylinder":
-            r = max(a.get("r1", 1.0), a.get("r2", 1.0))
-        elif node.name == "rotate_extrude":
-            r = 40.0           # the profile's reach (bounded by the model's size)
-        elif node.name == "linear_extrude" and a.get("twist", 0.0) != 0:
-            # slices: a point's arc becomes a chord, and each side quad (an edge of length
-            # L turned by alpha) becomes two triangles, off the ruled surface by L alpha / 4
-            alpha = math.radians(abs(a["twist"]) / a.get("slices", 1.0))
-            length, radius = _outline_size(node.children[0])
-            k = max(1.0, *np.atleast_1d(a.get("scale", 1.0)))
-            worst = max(worst, scale * k * (length * alpha / 4 + radius * (1 - math.cos(alpha / 2))))
-        if node.name == "linear_extrude":
-            # a scale unequal on the axes makes each side quad a bilinear patch, which
-            # its two triangles leave by a quarter of its twist vector's part off the
-            # patch: the unequal half of a slice's scale step dS times an edge p - q
-            step = 1.0 - np.broadcast_to(np.asarray(a.get("scale", 1.0), float), (2,))
-            if step[0] != step[1]:
-                length, _ = _outline_size(node.children[0])
-                worst = max(worst, scale * abs(step[0] - step[1]) / 2 / a.get("slices", 1.0)
-                            * length / 4)
-        if r is not None:
-            n = fragments(r, *res)
-            cos_lat = 1.0
-            if node.name == "sphere":
-                # OpenSCAD's sphere has (n + 1) // 2 rings of n-gons, none on the
-                # equator: a facet is off by a chord in longitude and in latitude
-                cos_lat = math.cos(math.pi / (2 * ((n + 1) // 2)))
-            worst = max(worst, scale * r * (1 - math.cos(math.pi / n) * cos_lat))
-        for c in node.children:
-            visit(c, scale)
-
-    for n in parse((FIXTURES / f"{model}.csg").read_text()):
-        visit(n, 1.0)
-    return worst
-
-
-def _outline_size(node) -> tuple[float, float]:
-    """Longest edge and farthest point of a 2D tree's leaves (square, circle, polygon)."""
-    if node.children:
-        sizes = [_outline_size(c) for c in node.children]
-        return max(s[0] for s in sizes), max(s[1] for s in sizes)
-    a = node.args
-    if node.name == "square":
-        size = np.broadcast_to(np.asarray(a.get("size", 1.0), dtype=float), (2,))
-        return float(size.max()), float(np.hypot(*size))
-    if node.name == "circle":
-        r = a.get("r", 1.0)
-        n = fragments(r, a.get("$fn", 0.0), a.get("$fs", 2.0), a.get("$fa", 12.0))
-        return 2 * r * math.sin(math.pi / n), r
-    pts = np.asarray(a["points"], dtype=float)
-    edges = np.linalg.norm(np.roll(pts, -1, 0) - pts, axis=1)
-    return float(edges.max()), float(np.linalg.norm(pts, axis=1).max())
+    """The largest chordal deviation of the model's facets (tests.support.facet_tolerance)."""
+    v, _ = as_triangles(str(FIXTURES / f"{model}.stl"))
+    return facet_tolerance((FIXTURES / f"{model}.csg").read_text(),
+                           float(np.hypot(v[:, 0], v[:, 1]).max()))
 
 
 @pytest.mark.parametrize("model", MODELS)
