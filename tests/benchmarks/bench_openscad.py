@@ -31,7 +31,9 @@ For every ``/usr/share/openscad/examples/**/*.scad``:
    voxel holds. With true curves, which may leave OpenSCAD's facets by their
    chordal error (:func:`tests.support.facet_tolerance.facet_tolerance`, reported
    in voxels), ``far`` counts STL voxels with no output voxel within one voxel
-   plus that error (chessboard steps). ``ratio`` is output voxels over STL voxels.
+   plus that error (chessboard steps; the true curves are voxelized on the STL's
+   lattice reaching that far past its bounds, where a true circle bulges beyond its
+   inscribed polygon). ``ratio`` is output voxels over STL voxels.
 
 Each model runs in a child process with a timeout. Writes the table
 ``openscad`` (the note of issue 17 quotes it). ``--constructs``: the same for
@@ -271,7 +273,15 @@ def child(csg_path: str, stl_path: str, res: int, scad: str, timeout: float) -> 
     v, f = as_triangles(stl_path)
     points = sample_surface(v[f], POINTS, np.random.default_rng(1))
     out = {"stl_voxels": stl.count}
+    # true curves may leave OpenSCAD's facets by their chordal error (in chessboard steps,
+    # plus one voxel); their grid reaches that far past the STL's on every side
+    h = np.asarray(stl.voxel_size)
+    tol = facet_tolerance(Path(csg_path).read_text(), float(np.hypot(v[:, 0], v[:, 1]).max()))
+    steps = 1 + int(np.ceil(tol / h.min() - 1e-9))
     for mode in ("openscad", "true"):
+        pad = 0 if mode == "openscad" else steps + 1
+        bounds = (tuple(np.asarray(stl.bounds[0]) - pad * h),
+                  tuple(np.asarray(stl.bounds[1]) + pad * h)) if pad else stl.bounds
         try:
             solid = csg.read_openscad(csg_path, facets=mode, base=base)
         except (ValueError, TypeError, OSError) as err:
@@ -279,7 +289,7 @@ def child(csg_path: str, stl_path: str, res: int, scad: str, timeout: float) -> 
             continue
         t = _cpu()
         try:
-            vox = solid.voxelize(bounds=stl.bounds, voxel_size=stl.voxel_size, workers=1)
+            vox = solid.voxelize(bounds=bounds, voxel_size=stl.voxel_size, workers=1)
         except (ValueError, MemoryError) as err:
             out[mode] = {"refused": f"voxelize: {str(err)[:110]}"}
             continue
@@ -293,23 +303,17 @@ def child(csg_path: str, stl_path: str, res: int, scad: str, timeout: float) -> 
                 cpu = min(cpu, _cpu() - t)
                 scad_cpu = min(scad_cpu, openscad_stl_cpu(scad_path, timeout))
             out["scad_cpu"] = scad_cpu
-        held = vox.contains(stl.coords())
+        held = vox.contains(stl.coords() + pad)
         row = {"cpu": cpu, "voxels": vox.count, "ratio": vox.count / max(stl.count, 1),
                "missed": int((~held).sum()), "points_out": misses(vox, points)}
         if mode == "openscad":
             depth = stl_depths(stl, v[f], stl.coords()[~held])
             row["grazed"] = int((depth <= 1).sum())          # within the STL's rounding
         if mode == "true":
-            # true curves may leave OpenSCAD's facets by their chordal error: STL voxels
-            # farther than one voxel plus that from every output voxel (chessboard steps)
-            tol = facet_tolerance(Path(csg_path).read_text(),
-                                  float(np.hypot(v[:, 0], v[:, 1]).max()))
-            steps = 1 + int(np.ceil(tol / min(stl.voxel_size) - 1e-9))
-            grid = vox.to_dense(interior=False)
-            away = distance_transform_cdt(~grid, metric="chessboard")
-            c = stl.coords()[~held].astype(np.int64)
+            away = distance_transform_cdt(~vox.to_dense(interior=False), metric="chessboard")
+            c = stl.coords()[~held].astype(np.int64) + pad
             row["far"] = int((away[c[:, 0], c[:, 1], c[:, 2]] > steps).sum())
-            row["chordal"] = tol / min(stl.voxel_size)
+            row["chordal"] = tol / h.min()
         out[mode] = row
     return out
 

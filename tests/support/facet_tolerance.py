@@ -30,8 +30,10 @@ def facet_tolerance(text: str, reach: float) -> float:
         nonlocal worst
         a = node.args
         if node.name == "multmatrix":
-            m = a.get("m", node.positional[0] if node.positional else None)
-            scale = scale * float(np.linalg.norm(np.array(m)[:3, :3], 2))
+            m = np.array(a.get("m", node.positional[0] if node.positional else None), float)
+            if not np.all(np.isfinite(m)):
+                return                               # OpenSCAD removes what it holds
+            scale = scale * float(np.linalg.norm(m[:3, :3], 2))
         res = (a.get("$fn", 0.0), a.get("$fs", 2.0), a.get("$fa", 12.0))
         r = None
         if node.name in ("sphere", "circle"):
