@@ -128,8 +128,7 @@ def _moved_piece(v: np.ndarray, f: np.ndarray, moved: np.ndarray):
     v = v @ moved[:3, :3].T + moved[:3, 3]
     if np.linalg.det(moved[:3, :3]) < 0:
         f = f[:, ::-1]                       # mirrored: keep the faces outward
-    used = np.unique(f.ravel())
-    return v[used] if is_convex_mesh(v, f) else MeshPiece(v, f)
+    return v[np.unique(f.ravel())] if is_convex_mesh(v, f) else MeshPiece(v, f)
 
 
 def _boolean_mesh(solid: Solid) -> tuple[np.ndarray, np.ndarray]:
@@ -159,13 +158,7 @@ def _boolean_vertices(solid: Solid) -> np.ndarray:
                                empty=True)
         flat = np.concatenate([np.asarray(q, dtype=np.float64) for q in paths]) / CLIPPER_SCALE
         return np.column_stack([flat, np.zeros(len(flat))])
-    try:
-        v, f = tree_mesh(solid, np.eye(4))
-    except NotAMesh as err:
-        raise NotAPolytope(str(err), curved=err.curved) from None
-    if not len(f):
-        raise NotAPolytope(f"the {type(solid).__name__.lower()} is empty: no vertices",
-                               empty=True)
+    v, f = _boolean_mesh(solid)
     return v[np.unique(f.ravel())]
 
 
