@@ -489,7 +489,7 @@ class _Builder:
             raise self.error(node, "polyhedron: points must be a list of finite [x, y, z]")
         if not isinstance(faces, list) or not faces:
             return self.skip(node, "it has no faces")
-        tris, quads, quad_faces, degenerate = [], [], [], 0
+        tris, quads, degenerate = [], [], 0
         for k, face in enumerate(faces):
             if not isinstance(face, list) or not all(isinstance(i, float) and math.isfinite(i)
                                                      for i in face):
@@ -507,15 +507,14 @@ class _Builder:
                 continue
             if len(idx) == 4:
                 quads.append(idx)
-                quad_faces.append(k)
             else:     # clockwise seen from outside, as OpenSCAD lists them: fanned reversed
                 tris += [(idx[0], idx[j + 1], idx[j]) for j in range(1, len(idx) - 1)]
         if degenerate == len(faces):
             return self.skip(node, "every face repeats a corner next to itself (fewer than "
                                    "3 corners): no surface")
-        ids = openscad_vertex_ids(v, [[int(i) for i in face] for face in faces])
-        quad_ids = np.array([ids[k] for k in quad_faces], dtype=np.int64).reshape(-1, 4)
-        quad_tris, alternatives = _quad_triangles(v, np.array(quads, dtype=np.int64), quad_ids)
+        quads = np.array(quads, dtype=np.int64).reshape(-1, 4)
+        numbers = openscad_vertex_ids(v, [[int(i) for i in face] for face in faces])
+        quad_tris, alternatives = _quad_triangles(v, quads, numbers[quads])
         return self._mesh(Polyhedron(v, np.concatenate([np.array(tris, dtype=np.int64)
                                                         .reshape(-1, 3), quad_tris]),
                                      alternatives))

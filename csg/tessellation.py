@@ -67,7 +67,8 @@ def quad_diagonals(quads: np.ndarray, corner_ids: Optional[np.ndarray] = None) -
     quads : (n, 4, 3) array
         Each face's corners in the file's order.
     corner_ids : (n, 4) int array, optional
-        OpenSCAD's numbers of those corners (:func:`openscad_vertex_ids`), which
+        OpenSCAD's numbers of those corners (:func:`openscad_vertex_ids` of their
+        points), which
         decide a bow tie's diagonal; without them a bow tie's is not known.
 
     Returns
@@ -136,11 +137,11 @@ def quad_diagonals(quads: np.ndarray, corner_ids: Optional[np.ndarray] = None) -
     return out
 
 
-def openscad_vertex_ids(points: np.ndarray, faces: list) -> list:
-    """OpenSCAD's number of each corner of each face (``Reindexer<Vector3f>`` in
-    ``tessellate_faces``): points at equal single-precision coordinates share one,
-    numbered in order of first use over the faces in file order, each face's
-    corners in reverse (the order OpenSCAD's polygons hold them)."""
+def openscad_vertex_ids(points: np.ndarray, faces: list) -> np.ndarray:
+    """OpenSCAD's number of each point (``Reindexer<Vector3f>`` in ``tessellate_faces``):
+    points at equal single-precision coordinates share one, numbered in order of
+    first use over the faces in file order, each face's corners in reverse (the
+    order OpenSCAD's polygons hold them); -1 for a point no face uses."""
     points = np.asarray(points, dtype=np.float64)
     _, key = np.unique(points.astype(np.float32), axis=0, return_inverse=True)
     key = key.reshape(-1)
@@ -152,7 +153,7 @@ def openscad_vertex_ids(points: np.ndarray, faces: list) -> list:
     number[np.argsort(first_use, kind="stable")] = np.arange(len(first_keys))
     per_key = np.full(int(key.max()) + 1 if len(key) else 0, -1, dtype=np.int64)
     per_key[first_keys] = number
-    return [per_key[key[np.asarray(f, dtype=np.int64)]] for f in faces]
+    return per_key[key]
 
 
 #: buckets of a small ``std::unordered_map`` in GCC 12's libstdc++ (its first allocation)

@@ -40,7 +40,7 @@ def test_every_diagonal_is_the_one_in_openscads_stl():
                             np.cross(corners[:, 2] - corners[:, 0],
                                      corners[:, 3] - corners[:, 1]))) > 1e-6
     assert bent.sum() >= 60                      # the fixture is worth its name
-    ids = np.array(openscad_vertex_ids(points, faces))[[len(q) == 4 for q in faces]]
+    ids = openscad_vertex_ids(points, faces)[quads]
     diagonal = quad_diagonals(corners, ids)
     assert (diagonal >= 0).all()
     # its bow ties are decided by OpenSCAD's vertex numbers: without, they are not known
@@ -71,12 +71,16 @@ def test_a_quad_of_unknown_cut_keeps_both_diagonals_as_surface():
                        [10, -20, 20], [10, -20, 30], [0, -20, 30]], dtype=float)
     faces = [[0, 1, 2, 3], [4, 5, 6, 7], [1, 2, 5, 4], [2, 3, 6, 5], [3, 0, 6, 5],
              [0, 1, 4, 7]]
-    ids = np.array(openscad_vertex_ids(points, faces))
+    ids = openscad_vertex_ids(points, faces)[np.array(faces)]
     # the others as OpenSCAD 2021.01's STL of issue964 cuts them (1-5, 3-6 and 0-4 through
     # a spike at a corner, the planar ones either way)
     assert quad_diagonals(points[np.array(faces)], ids).tolist() == [0, 1, 0, -1, 0, 0]
     solid = csg.read_openscad(f"polyhedron(points = {points.tolist()}, faces = {faces});")
     assert len(solid.alternative_faces) == 4
+    # a face listing a corner twice in a row is that quad, numbered alike
+    again = csg.read_openscad(f"polyhedron(points = {points.tolist()}, "
+                              f"faces = {faces[:3] + [[2, 3, 3, 6, 5]] + faces[4:]});")
+    assert np.array_equal(again.faces, solid.faces)
     vox = iv.voxelize(solid, 48, workers=1)
     quad = points[[2, 3, 6, 5]]
     for tri in [(0, 1, 2), (0, 2, 3), (0, 1, 3), (1, 2, 3)]:     # either cut of the quad
