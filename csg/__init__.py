@@ -22,6 +22,7 @@ from .blends import Blobby, smooth_difference, smooth_intersection, smooth_union
 from .polytopes import NotAPolytope, hull, minkowski
 from .openscad import read_openscad
 from .openscad_parser import OpenSCADError, OpenSCADWarning
+from .scad import OpenSCADNotFound
 from .scene import SceneError, load_json
 
 __all__ = [
@@ -32,5 +33,6 @@ __all__ = [
     "Circle", "Rectangle", "Polygon", "linear_extrude", "rotate_extrude",
     "smooth_union", "smooth_intersection", "smooth_difference", "Blobby",
     "hull", "minkowski", "NotAPolytope",
-    "read_openscad", "OpenSCADError", "OpenSCADWarning", "load_json", "SceneError",
+    "read_openscad", "OpenSCADError", "OpenSCADWarning", "OpenSCADNotFound", "load_json",
+    "SceneError",
 ]

@@ -51,7 +51,8 @@ CSG_ALL = [
     "rotation_matrix", "Sphere", "Box", "Cylinder", "Torus", "Ellipsoid", "Capsule", "HalfSpace",
     "ConvexPolyhedron", "Polyhedron", "Circle", "Rectangle", "Polygon", "linear_extrude",
     "rotate_extrude", "smooth_union", "smooth_intersection", "smooth_difference", "Blobby",
-    "read_openscad", "OpenSCADError", "OpenSCADWarning", "load_json", "SceneError",
+    "read_openscad", "OpenSCADError", "OpenSCADWarning", "OpenSCADNotFound", "load_json",
+    "SceneError",
     "hull", "minkowski", "NotAPolytope",
 ]
 
