@@ -272,13 +272,22 @@ def _sum_pairs(first: list, second: list) -> list:
     """The pieces of the sum of two operands' pieces (convex vertex sets and
     :class:`MeshPiece` s): see :func:`minkowski`; bounded by :data:`MAX_PIECES` and
     :data:`MAX_SUMS` before anything is summed."""
-    def size(p) -> tuple[int, int]:          # (pieces it makes per convex partner, points)
-        return (len(p.faces), 3 * len(p.faces)) if isinstance(p, MeshPiece) else (1, len(p))
-    pieces = sum(size(a)[0] * size(b)[0] + 2 for a in first for b in second)
+    def faces(p) -> int:                     # a mesh's triangles; 0 for a convex piece
+        return len(p.faces) if isinstance(p, MeshPiece) else 0
+
+    def points(p) -> int:                    # the points it brings to each sum
+        return 3 * len(p.faces) if isinstance(p, MeshPiece) else len(p)
+
+    # per pair (see _sum_pair): convex and convex 1 hull; a mesh and a convex piece a
+    # hull per triangle and the moved mesh; two meshes a hull per pair of triangles and
+    # at most one moved copy of each per triangle of the other
+    pieces = sum(max(faces(a), 1) * max(faces(b), 1) + (faces(a) > 0) + (faces(b) > 0) +
+                 (faces(a) + faces(b) if faces(a) and faces(b) else 0)
+                 for a in first for b in second)
     if pieces > MAX_PIECES:
         raise ValueError(f"minkowski: {pieces:,} pieces, over the limit of {MAX_PIECES:,} "
                          "(csg.polytopes.MAX_PIECES)")
-    count = sum(size(a)[1] for a in first) * sum(size(b)[1] for b in second)
+    count = sum(points(a) for a in first) * sum(points(b) for b in second)
     if count > MAX_SUMS:
         raise ValueError(f"minkowski: {count:,} vertex sums, over the limit of "
                          f"{MAX_SUMS:,} (csg.polytopes.MAX_SUMS)")

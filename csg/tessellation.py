@@ -68,8 +68,7 @@ def quad_diagonals(quads: np.ndarray, corner_ids: Optional[np.ndarray] = None) -
         Each face's corners in the file's order.
     corner_ids : (n, 4) int array, optional
         OpenSCAD's numbers of those corners (:func:`openscad_vertex_ids` of their
-        points), which
-        decide a bow tie's diagonal; without them a bow tie's is not known.
+        points), which decide a bow tie's diagonal; without them it is not known.
 
     Returns
     -------
@@ -114,8 +113,6 @@ def quad_diagonals(quads: np.ndarray, corner_ids: Optional[np.ndarray] = None) -
     # a dart: the only diagonal inside it, through its reflex corner (no flip passes it)
     odd_sign = np.where((positive == 1)[:, None], turn > 0, turn < 0)
     diagonal = np.where(dart, np.argmax(odd_sign, axis=1) % 2, diagonal)
-    # back to the file's order: corner k of the reversed quad is corner 3 - k, and
-    # 3 - k has the parity of k + 1: the diagonal 0-2 there is 3-1 here
     # one corner on the line through its neighbours: the quad is a triangle with a
     # corner on an edge (libtess2 cuts through that corner) or with a spike that turns
     # back at it (libtess2 keeps the triangle; the spike's corner is OpenSCAD's ear)
@@ -127,6 +124,8 @@ def quad_diagonals(quads: np.ndarray, corner_ids: Optional[np.ndarray] = None) -
     flat = np.isfinite(norm).all(axis=1) & (absn.max(axis=1) > 0) & \
         ((turn == 0).sum(axis=1) == 1) & (back | (positive == 3) | (negative == 3))
     diagonal = np.where(flat, np.where(back, (corner + 1) % 2, corner % 2), diagonal)
+    # back to the file's order: corner k of the reversed quad is corner 3 - k, and
+    # 3 - k has the parity of k + 1: the diagonal 0-2 there is 3-1 here
     out = (1 - diagonal).astype(np.int8)
     if corner_ids is not None and bow_tie.any():
         ids = np.asarray(corner_ids, dtype=np.int64).reshape(-1, 4)[bow_tie]
@@ -162,8 +161,8 @@ _BUCKETS = 13
 
 def _bow_tie_diagonals(ids: np.ndarray) -> np.ndarray:
     """The diagonal OpenSCAD takes across bow ties whose corners carry OpenSCAD's numbers
-    ``ids (n, 4)`` in its polygon order (the file's reversed), as 0 (its corners 0-2 in
-    that order... returned in the file's order) or 1.
+    ``ids (n, 4)``, given in its polygon order (the file's reversed); returned in the
+    file's order, as :func:`quad_diagonals` returns it (0: corners 0-2, 1: corners 1-3).
 
     libtess2 cuts a bow tie at its crossing point; OpenSCAD drops the triangles that
     use that new point (``tessellatePolygonWithHoles``) and closes the loop that is
@@ -173,7 +172,8 @@ def _bow_tie_diagonals(ids: np.ndarray) -> np.ndarray:
     the diagonal between that vertex's neighbours; iteration orders follow
     libstdc++ (13 buckets, a new bucket's node first, a node first in its bucket)
     and Boost 1.74's pair hash, as Debian's build of OpenSCAD 2021.01 has them
-    (checked on 40 bow ties of OpenSCAD's own STL exports).
+    (checked on every bow tie among the bent faces of 560 random boxes, and of
+    OpenSCAD's test models, against OpenSCAD's own STL exports).
     """
     edges_from = ids
     edges_to = np.roll(ids, -1, axis=1)

@@ -160,6 +160,13 @@ def load_model(path: str, **options: Any) -> Any:
     return namespace["shape"]
 
 
+def _facets_option(command: argparse.ArgumentParser) -> None:
+    """The one ``--facets`` option of the commands that read models."""
+    command.add_argument("--facets", choices=["openscad", "true"], default="openscad",
+                         help=".csg and .scad models: OpenSCAD's own facets (default), or "
+                              "true curves")
+
+
 def _parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="implicitvox",
                                      description="Robust voxelization of implicit solids.",
@@ -182,9 +189,7 @@ def _parser() -> argparse.ArgumentParser:
     size.add_argument("--voxel-size", type=float, metavar="H", help="the voxels' edge length")
     vox.add_argument("--bounds", type=float, nargs=6, metavar=("X0", "Y0", "Z0", "X1", "Y1", "Z1"))
     vox.add_argument("--interior", action="store_true", help="also find interior octants")
-    vox.add_argument("--facets", choices=["openscad", "true"], default="openscad",
-                     help=".csg and .scad models: OpenSCAD's own facets (default), or "
-                          "true curves")
+    _facets_option(vox)
     vox.add_argument("--normals", action="store_true", help="store normals")
     vox.add_argument("--mean-value", action="store_true",
                      help="tighter: mean value form on ambiguous octants (about 3x the time)")
@@ -217,9 +222,7 @@ def _parser() -> argparse.ArgumentParser:
                      help="voxels around the surface (default 4; 0: every voxel)")
     fld.add_argument("--tolerance", type=float, metavar="E",
                      help="error target of certified distances (default 1e-3 voxel)")
-    fld.add_argument("--facets", choices=["openscad", "true"], default="openscad",
-                     help=".csg and .scad models: OpenSCAD's own facets (default), or "
-                          "true curves")
+    _facets_option(fld)
     fld.add_argument("--out", help="write .npz (lossless) or .vti")
     fld.add_argument("--render", metavar="PNG", help="render the 0-isosurface")
     fld.add_argument("--check-suitability", action="store_true",
@@ -238,9 +241,7 @@ def _parser() -> argparse.ArgumentParser:
     size.add_argument("--resolution", type=int,
                       help="cells along the longest side (the bound is sqrt(3) cells)")
     msh.add_argument("--bounds", type=float, nargs=6, metavar=("X0", "Y0", "Z0", "X1", "Y1", "Z1"))
-    msh.add_argument("--facets", choices=["openscad", "true"], default="openscad",
-                     help=".csg and .scad models: OpenSCAD's own facets (default), or "
-                          "true curves")
+    _facets_option(msh)
     msh.add_argument("--refine", type=int, default=REFINE, metavar="K",
                      help=f"levels complex cells may be split below the largest (default {REFINE})")
     msh.add_argument("--no-prune", dest="prune", action="store_false",
