@@ -36,7 +36,7 @@ import numpy as np
 from ..octree import morton
 from ..octree.grid import Grid
 from .ranges import expand_boxes
-from .tribox import Triangles, vertex_in_box
+from .tribox import Triangles
 from .. import batches
 from ..parallel import PIECES_PER_WORKER, Job, farm
 
@@ -46,7 +46,6 @@ __all__ = ["surface_codes", "start_pairs", "run_pairs", "split_pairs", "PairsJob
 #: (node, triangle) pairs per chunk
 CHUNK = batches.TRIANGLE_PAIRS
 
-_OFFSETS = morton.CORNERS
 
 
 def _boxes(grid: Grid, level: int, nodes: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -62,75 +61,39 @@ def _boxes(grid: Grid, level: int, nodes: np.ndarray) -> tuple[np.ndarray, np.nd
     return lo, hi
 
 
-def _candidates(tris: Triangles, grid: Grid, level: int, nodes: np.ndarray, tri: np.ndarray):
-    """Children at ``level + 1`` that the triangles' bounding boxes reach, with their boxes
-    and whether the box holds the whole bounding box (then the triangle meets it)."""
-    scale = 1 << (grid.depth - level - 1)
-    shape = np.asarray(grid.shape, dtype=np.int64)
-    split = (2 * nodes + 1) * scale                  # first voxel of the upper child
-    tlo, thi = tris.lo[tri], tris.hi[tri]
-    ok = np.ones((len(nodes), 8), dtype=bool)
-    for a in range(3):
-        exists_hi = split[:, a] < shape[a]
-        mid = grid.edge(a, np.minimum(split[:, a], shape[a]))
-        low_ok = tlo[:, a] <= mid
-        high_ok = exists_hi & (thi[:, a] >= mid)
-        bit = _OFFSETS[:, a].astype(bool)
-        ok &= np.where(bit[None, :], high_ok[:, None], low_ok[:, None])
-    pair, octant = np.nonzero(ok)
-    child = 2 * nodes[pair] + _OFFSETS[octant]
-    tri = tri[pair]
-    lo, hi = _boxes(grid, level + 1, child)
-    holds = np.all((lo <= tris.lo[tri]) & (tris.hi[tri] <= hi), axis=1)
-    return child, tri, lo, hi, holds
-
-
 def _children(tris: Triangles, grid: Grid, level: int, nodes: np.ndarray,
               tri: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Children at ``level + 1`` of pairs ``(nodes, tri)`` that meet their triangle."""
-    child, tri, lo, hi, holds = _candidates(tris, grid, level, nodes, tri)
-    test = np.flatnonzero(~holds)
-    if len(test):
-        holds[test] = tris.meet_overlapping(tri[test], lo[test], hi[test])
-    return child[holds], tri[holds]
+    """Children at ``level + 1`` of pairs ``(nodes, tri)`` that meet their triangle
+    (compiled: :func:`implicitvox.triangles.pair_kernels.child_pairs`; the pairs
+    its filters leave unsure on the exact path)."""
+    from .pair_kernels import child_pairs     # (loads Numba: not at import)
+    from .tribox_kernels import UNSURE
+    child, tri, lo, hi, state = child_pairs(tris, grid, level, nodes, tri)
+    keep = state == 1
+    unsure = np.flatnonzero(state == UNSURE)
+    if len(unsure):
+        keep[unsure] = tris.meet_by_arrays(tri[unsure], lo[unsure], hi[unsure])
+    return child[keep], tri[keep]
 
 
 def _leaf_codes(tris: Triangles, grid: Grid, nodes: np.ndarray, tri: np.ndarray) -> np.ndarray:
     """Morton codes of the voxels (children of ``nodes``) that some triangle meets.
 
-    A voxel needs one witness. Candidates are grouped by voxel (one sort);
-    cheap exact accepts run first (the voxel holds the triangle's bounding
-    box or a vertex; then the plane stage of the box test), and the costly
-    edge stage runs in rounds on one candidate per still-open voxel.
+    A voxel needs one witness: the candidates (children the triangles' bounding
+    boxes reach) are grouped by voxel (one sort), and each voxel's are tested
+    in order until one meets
+    (:meth:`~implicitvox.triangles.tribox.Triangles.meet_any`).
     """
-    child, tri, lo, hi, holds = _candidates(tris, grid, grid.depth - 1, nodes, tri)
+    from .pair_kernels import child_pairs     # (loads Numba: not at import)
+    child, tri, lo, hi, _ = child_pairs(tris, grid, grid.depth - 1, nodes, tri, test=False)
     codes = morton.encode(child)
     order = np.argsort(codes, kind="stable")
-    codes, tri, lo, hi, holds = codes[order], tri[order], lo[order], hi[order], holds[order]
+    codes, tri, lo, hi = codes[order], tri[order], lo[order], hi[order]
     new = np.empty(len(codes), dtype=bool)
     new[:1] = True
     np.not_equal(codes[1:], codes[:-1], out=new[1:])
-    group = np.cumsum(new) - 1
-    done = np.zeros(int(group[-1]) + 1 if len(group) else 0, dtype=bool)
-    done[group[holds]] = True
-    lo, hi = tris.grown(tri, lo, hi)
-    pending = np.flatnonzero(~done[group])
-    meets, undecided = tris.plane_stage(tri[pending], lo[pending], hi[pending])
-    done[group[pending[meets]]] = True
-    pending = pending[undecided]
-    while len(pending):
-        pending = pending[~done[group[pending]]]
-        if not len(pending):
-            break
-        g = group[pending]
-        first = np.empty(len(pending), dtype=bool)
-        first[:1] = True
-        np.not_equal(g[1:], g[:-1], out=first[1:])
-        test = pending[first]
-        met = tris.edge_stage(tri[test], lo[test], hi[test])
-        done[group[test[met]]] = True
-        pending = pending[~first]
-    return codes[new][done]
+    start = np.append(np.flatnonzero(new), len(codes))
+    return codes[new][tris.meet_any(tri, lo, hi, start)]
 
 
 def _first_voxel(grid: Grid, axis: int, t: np.ndarray) -> np.ndarray:

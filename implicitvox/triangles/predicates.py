@@ -186,6 +186,8 @@ class FixedPlanes:
         #: "filtered" (0 or 1): one gather per query (rows stay contiguous)
         self._table = np.concatenate([a.T, self.normal.T, self.weight.T,
                                       ok[None, :].astype(np.float64)])
+        #: the same per triangle, one row each ``(t, 10)``: for compiled loops
+        self.rows = np.ascontiguousarray(self._table.T)
 
     def sign(self, which: np.ndarray, d: np.ndarray) -> np.ndarray:
         """Sign of ``orient3d(a[which], b[which], c[which], d)`` per row, exactly."""

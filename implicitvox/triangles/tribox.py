@@ -101,6 +101,10 @@ class Triangles:
     def meet_boxes(self, tri: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
         """Whether triangle ``tri[k]`` meets the closed box ``[lo[k], hi[k]]``.
 
+        The compiled kernel (:func:`implicitvox.triangles.tribox_kernels.meet_pairs`)
+        answers every pair its floating-point filters certify; the few it cannot
+        go to :meth:`meet_by_arrays`, whose predicates fall back to exact integers.
+
         Parameters
         ----------
         tri : ndarray of int, (m,)
@@ -112,19 +116,56 @@ class Triangles:
         -------
         ndarray of bool, (m,)
         """
-        out = np.zeros(len(tri), dtype=bool)
-        alive = np.flatnonzero(np.all((self.lo[tri] <= hi) & (self.hi[tri] >= lo), axis=1))
-        out[alive] = self.meet_overlapping(tri[alive], lo[alive], hi[alive])
+        from .tribox_kernels import UNSURE, meet_pairs     # (loads Numba: not at import)
+        answer = meet_pairs(self, tri, lo, hi)
+        out = answer == 1
+        unsure = np.flatnonzero(answer == UNSURE)
+        if len(unsure):
+            out[unsure] = self.meet_by_arrays(tri[unsure], lo[unsure], hi[unsure])
         return out
 
-    def meet_overlapping(self, tri: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
-        """:meth:`meet_boxes` for boxes already known to overlap their triangle's
-        bounding box (the box-normal axes are settled)."""
-        lo, hi = self.grown(tri, lo, hi)
+    def meet_any(self, tri: np.ndarray, lo: np.ndarray, hi: np.ndarray,
+                 start: np.ndarray) -> np.ndarray:
+        """Per group of pairs ``start[g]:start[g + 1]``, whether one of them meets
+        (:meth:`meet_boxes` of any): a group's pairs are tested in order until one
+        meets, so a voxel with many candidates costs one witness.
+
+        Parameters
+        ----------
+        tri : ndarray of int, (m,)
+        lo, hi : ndarray, (m, 3)
+        start : ndarray of int, (g + 1,)
+            Increasing, from 0 to ``m``.
+
+        Returns
+        -------
+        ndarray of bool, (g,)
+        """
+        from .tribox_kernels import UNSURE, meet_any_pairs     # (loads Numba: not at import)
+        groups, pairs = meet_any_pairs(self, tri, lo, hi, start)
+        out = groups == 1
+        open_ = np.flatnonzero(groups == UNSURE)
+        if len(open_):
+            owner = np.repeat(np.arange(len(groups)), np.diff(start))
+            unsure = np.flatnonzero((pairs == UNSURE) & (groups[owner] == UNSURE))
+            met = self.meet_by_arrays(tri[unsure], lo[unsure], hi[unsure])
+            out[owner[unsure[met]]] = True
+        return out
+
+    def meet_by_arrays(self, tri: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+        """:meth:`meet_boxes` stage by stage over whole arrays, every predicate exact
+        (filtered, then exact integers): the path for the pairs the compiled
+        kernel leaves unsure, and the oracle the tests hold the kernel to."""
+        out = np.zeros(len(tri), dtype=bool)
+        alive = np.flatnonzero(np.all((self.lo[tri] <= hi) & (self.hi[tri] >= lo), axis=1))
+        if not len(alive):
+            return out
+        tri, lo, hi = tri[alive], *self.grown(tri[alive], lo[alive], hi[alive])
         meets, open_ = self.plane_stage(tri, lo, hi)
         undecided = np.flatnonzero(open_)
         meets[undecided] = self.edge_stage(tri[undecided], lo[undecided], hi[undecided])
-        return meets
+        out[alive] = meets
+        return out
 
     @functools.cached_property
     def planes(self) -> FixedPlanes:
@@ -136,8 +177,20 @@ class Triangles:
         ``tri``: ``1`` strictly on the side its normal ``(v1 - v0) x (v2 - v0)``
         points to, ``-1`` strictly on the other, ``0`` where the box meets the
         plane (a degenerate triangle's "plane" is everywhere: 0). Exact: the
-        ``orient3d`` signs of the box corners least and greatest along the normal.
+        ``orient3d`` signs of the box corners least and greatest along the normal,
+        compiled (:func:`implicitvox.triangles.tribox_kernels.plane_side_pairs`),
+        the pairs its filter leaves unsure on :meth:`plane_sides_by_arrays`.
         """
+        from .tribox_kernels import UNSURE, plane_side_pairs     # (loads Numba: not at import)
+        side = plane_side_pairs(self, tri, lo, hi)
+        unsure = np.flatnonzero(side == UNSURE)
+        if len(unsure):
+            side[unsure] = self.plane_sides_by_arrays(tri[unsure], lo[unsure], hi[unsure])
+        return side
+
+    def plane_sides_by_arrays(self, tri: np.ndarray, lo: np.ndarray, hi: np.ndarray
+                              ) -> np.ndarray:
+        """:meth:`plane_sides` over whole arrays (:class:`FixedPlanes`, exact)."""
         positive = self.normal_sign[tri] >= 0
         cmin = np.where(positive, lo, hi)
         side = (self.planes.sign(tri, cmin) > 0).astype(np.int8)
@@ -167,7 +220,7 @@ class Triangles:
         alive = np.flatnonzero(~meets)
         v, lo, hi = self.v[tri[alive]], lo[alive], hi[alive]
         sign = self.normal_sign[tri[alive]]
-        keep = self.plane_sides(tri[alive], lo, hi) == 0
+        keep = self.plane_sides_by_arrays(tri[alive], lo, hi) == 0
         axis = self.axis[tri[alive]]
         for i, (j, l) in enumerate(_PLANES):
             cand = np.flatnonzero(keep & (axis == i))

@@ -11,7 +11,12 @@ Prints per resolution, in the same run:
   (C++, exact box-triangle test per triangle's bounding box): the same figures;
 * trimesh ``voxelized`` (subdivide until edges are short, mark vertices): the same;
 * Varadhan et al. Table 2 beside it: bunny at 64^3, 128^3, 256^3 in 1.65, 2.01, 3.51 s (1.6 GHz Pentium IV, 2003);
-* the Utah teapot's 32 Bézier patches (``voxelize_bezier``) at each resolution.
+* the Utah teapot's 32 Bézier patches (``voxelize_bezier``) at each resolution;
+* the box-triangle test itself on the pairs the bunny's descent tests at 256³ (the
+  children its triangles' bounding boxes reach, one level above the voxels): ns per
+  pair, the compiled kernel (:func:`implicitvox.triangles.tribox_kernels.meet_pairs`,
+  with the exact path for the pairs it is unsure of) against the array path
+  (``Triangles.meet_by_arrays``), alternating, best of ``--repeat``, the answers equal.
 """
 from __future__ import annotations
 
@@ -49,6 +54,35 @@ def missed_share(index_sets: set, idx: np.ndarray) -> float:
 def keys_of(idx: np.ndarray) -> np.ndarray:
     idx = idx.astype(np.int64)
     return np.unique(idx[:, 0] * 1_000_003 ** 2 + idx[:, 1] * 1_000_003 + idx[:, 2])
+
+
+def box_test_row(tri: np.ndarray, repeat: int) -> list:
+    """The box-triangle test per pair, compiled against the array path (see the docstring)."""
+    from implicitvox.octree.grid import Grid
+    from implicitvox.triangles.pair_kernels import child_pairs
+    from implicitvox.triangles.pairs import start_pairs
+    from implicitvox.triangles.tribox import Triangles
+    tris = Triangles(tri)
+    grid = Grid.from_bounds((tuple(tri.min(axis=(0, 1))), tuple(tri.max(axis=(0, 1)))), 256)
+    stack, _ = start_pairs(tris, grid)
+    level, nodes, t, _ = max(stack, key=lambda entry: (entry[0], len(entry[1])))
+    _, t, lo, hi, _ = child_pairs(tris, grid, level, nodes, t, test=False)
+    ids = np.arange(len(t))
+    best = {"compiled": np.inf, "arrays": np.inf}
+    answers = {}
+    for _ in range(max(repeat, 2)):
+        for name, run in (("compiled", tris.meet_boxes), ("arrays", tris.meet_by_arrays)):
+            start = time.process_time()
+            answers[name] = run(t, lo, hi)
+            best[name] = min(best[name], time.process_time() - start)
+    assert np.array_equal(answers["compiled"], answers["arrays"])
+    ns = {k: 1e9 * v / len(ids) for k, v in best.items()}
+    print(f"\nbox-triangle test, {len(ids):,} pairs of the bunny at 256³ (level {level + 1}): "
+          f"compiled {ns['compiled']:.0f} ns/pair, arrays {ns['arrays']:.0f} ns/pair, "
+          f"{ns['arrays'] / ns['compiled']:.1f}x; {answers['arrays'].mean():.0%} meet")
+    return ["bunny", "256³", "box-triangle test per pair: compiled / array path",
+            f"{ns['compiled']:.0f} / {ns['arrays']:.0f} ns ({ns['arrays'] / ns['compiled']:.1f}x)",
+            f"{len(ids):,} pairs", "-", ""]
 
 
 def main() -> None:
@@ -112,6 +146,7 @@ def main() -> None:
         print(f"{n:>5} {'implicitvox':<12} {secs:8.3f} {vox.count:>10,}")
         rows.append(["Utah teapot, 32 patches", f"{n}³", "implicitvox voxelize_bezier",
                      f"{secs:.2f}", f"{vox.count:,}", "-", ""])
+    rows.append(box_test_row(tri, args.repeat))
     tables.write("mesh", ["model", "N", "tool", "seconds (best of repeats)", "voxels",
                           "surface samples missed", "Varadhan Table 2 (s)"], rows,
                  "python tests/benchmarks/bench_mesh.py " + " ".join(sys.argv[1:]), load)

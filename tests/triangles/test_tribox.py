@@ -73,3 +73,59 @@ def test_dilation_covers_the_grown_triangle():
     assert Triangles(tri, d).meet_boxes(np.arange(n), lo, hi).all()
     with pytest.raises(ValueError, match="dilation"):
         Triangles(tri, -d)
+
+
+def _cases(n=1500, seed=11):
+    """General, grid-aligned and degenerate pairs with boxes touching their triangles."""
+    rng = np.random.default_rng(seed)
+    tri = rng.uniform(-1, 1, (n, 3, 3))
+    tri[n // 4: n // 2] = np.round(tri[n // 4: n // 2] * 8) / 8          # ties
+    tri[n // 2: n // 2 + 100, 2] = tri[n // 2: n // 2 + 100, 0]          # segments
+    tri[n // 2 + 100: n // 2 + 200, :, 2] = 0.25                         # axis planes
+    size = rng.choice([0.125, 0.25, 0.5], (n, 1))
+    near = np.einsum("ni,nij->nj", rng.dirichlet([1, 1, 1], n), tri)   # a point on each
+    lo = near - size * rng.uniform(-0.5, 1, (n, 3))
+    lo[: n // 2 + 200] = np.round(lo[: n // 2 + 200] * 8) / 8
+    return tri, lo, lo + size
+
+
+def test_the_compiled_kernel_is_the_array_path():
+    """Every answer the compiled filter gives equals the array path's (exact predicates),
+    and :meth:`Triangles.meet_boxes` (kernel, then the array path for the unsure pairs)
+    equals it everywhere; scaled by 2**-1000 (products underflow: the kernel is unsure
+    of nearly every sign) the answers are the same, settled by the exact path."""
+    from implicitvox.triangles.tribox_kernels import UNSURE, meet_pairs
+    tri, lo, hi = _cases()
+    ids = np.arange(len(tri))
+    t = Triangles(tri)
+    want = t.meet_by_arrays(ids, lo, hi)
+    assert 0.2 < want.mean() < 0.8
+    raw = meet_pairs(t, ids, lo, hi)
+    sure = raw != UNSURE
+    assert sure.mean() > 0.9
+    assert (raw[sure] == 1).tolist() == want[sure].tolist()
+    assert t.meet_boxes(ids, lo, hi).tolist() == want.tolist()
+    s = 2.0 ** -1000
+    tiny = Triangles(tri * s)
+    assert (meet_pairs(tiny, ids, lo * s, hi * s) == UNSURE).mean() > 0.5
+    assert tiny.meet_boxes(ids, lo * s, hi * s).tolist() == want.tolist()
+
+
+def test_plane_sides_and_witness_groups_are_the_array_path():
+    """The compiled plane sides equal the array path's (ties at 0 included); a group
+    of pairs meets iff one of its pairs does."""
+    tri, lo, hi = _cases(seed=12)
+    ids = np.arange(len(tri))
+    t = Triangles(tri)
+    want = t.plane_sides_by_arrays(ids, lo, hi)
+    assert set(want.tolist()) == {-1, 0, 1}
+    assert t.plane_sides(ids, lo, hi).tolist() == want.tolist()
+    met = t.meet_by_arrays(ids, lo, hi)
+    rng = np.random.default_rng(13)
+    start = np.unique(np.concatenate([[0, len(ids)], rng.integers(0, len(ids), 300)]))
+    owner = np.repeat(np.arange(len(start) - 1), np.diff(start))
+    any_met = np.bincount(owner, weights=met, minlength=len(start) - 1) > 0
+    assert 0.1 < any_met.mean() < 1.0
+    assert t.meet_any(ids, lo, hi, start).tolist() == any_met.tolist()
+    s = 2.0 ** -1000
+    assert Triangles(tri * s).meet_any(ids, lo * s, hi * s, start).tolist() == any_met.tolist()
