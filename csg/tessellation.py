@@ -13,7 +13,8 @@ repeats libtess2's steps for one quad, in single precision as libtess2 computes
    the front);
 2. libtess2's normal (``ComputeNormal``: the corners farthest apart along the
    axis of largest extent, and the corner making the largest triangle with
-   them), and the projection that drops the normal's longest axis
+   them, the first found on ties in the order of libtess2's vertex list: the
+   contour from its second corner on, its first corner last), and the projection that drops the normal's longest axis
    (``tessProjectPolygon``: ``s`` the next axis, ``t`` the one after, signed by
    the normal, then flipped so that the contour's area is positive:
    ``CheckOrientation``);
@@ -30,14 +31,21 @@ libtess2 inserts the crossing point, OpenSCAD drops the triangles that use it an
 closes the loop that is left from hash maps) where that loop closing cuts, which
 needs OpenSCAD's numbers of the corners (:func:`openscad_vertex_ids`); a quad
 with one corner on the line through its neighbours as a triangle with a corner on
-an edge (cut through it) or with a spike (the spike's corner is the ear). A quad
-whose projection is degenerate otherwise (two corners on one point) is not
-known: :func:`quad_diagonals` says ``-1`` and the caller keeps both diagonals as
-surface. Checked against OpenSCAD 2021.01's own STL exports: every diagonal of the
-3,325 bent faces of 560 randomly bent boxes (bow ties and darts among them), and of
-OpenSCAD's test models
-``issue1061.scad``, ``issue964b.scad`` and ``issue964.scad`` (``tests/openscad/bent.scad``
-and ``tests/csg/test_tessellation.py`` keep a sample).
+an edge (cut through it) or with a spike (the spike's corner is the ear). Two
+corners on one point of the projection: neighbours are merged by libtess2
+(``RemoveDegenerateEdges`` keeps the first corner of their edge in contour order,
+the second for the edge out of the contour's first corner), which cuts the
+triangle left, and OpenSCAD closes the face with the merged corner's triangle: the
+diagonal runs through the corner kept; opposite corners leave a projection of no
+area, nothing is cut, and OpenSCAD closes the loop as a bow tie's. A quad with no
+normal (its corners on a line, or not finite) is not known: :func:`quad_diagonals`
+says ``-1`` and the caller keeps both diagonals as surface. Checked against
+OpenSCAD 2021.01's own STL exports: every diagonal of the 3,325 bent faces of 560
+randomly bent boxes (bow ties and darts among them), of 2,300 random quads with two
+corners on one projected point and 1,900 random integer quads (ties in the normal),
+and of OpenSCAD's test models ``issue1061.scad``, ``issue964b.scad`` and
+``issue964.scad`` (``tests/openscad/bent.scad``, ``tests/openscad/pinched.scad`` and
+``tests/csg/test_tessellation.py`` keep samples).
 
 Examples
 --------
@@ -74,13 +82,16 @@ def quad_diagonals(quads: np.ndarray, corner_ids: Optional[np.ndarray] = None) -
     -------
     (n,) int8 array
         0: the diagonal from corner 0 to corner 2; 1: from corner 1 to corner 3;
-        -1: not known here (a bow tie without ``corner_ids``, or a degenerate quad).
+        -1: not known here (a bow tie, or two opposite corners on one projected
+        point, without ``corner_ids``; a quad with no normal).
     """
     quads = np.asarray(quads, dtype=np.float64).reshape(-1, 4, 3)
     n = len(quads)
     q = quads[:, ::-1].astype(np.float32)                 # OpenSCAD's (reversed) order
     rows = np.arange(n)
-    norm = _libtess_normal(q)
+    # (libtess2's vertex list holds the contour from its second corner on, the first last:
+    # ComputeNormal's "first found" on ties counts in that order)
+    norm = _libtess_normal(np.roll(q, -1, axis=1))
     absn = np.abs(norm)
     axis = np.zeros(n, dtype=np.int64)                    # LongAxis: the first largest
     axis[absn[:, 1] > absn[:, 0]] = 1
@@ -133,6 +144,26 @@ def quad_diagonals(quads: np.ndarray, corner_ids: Optional[np.ndarray] = None) -
     else:
         out[bow_tie] = -1
     out[~proper & ~flat] = -1
+    # two neighbouring corners on one point of the projection: libtess2 merges them
+    # (RemoveDegenerateEdges keeps the edge's first corner in its contour order, the
+    # second for the edge out of the first corner added), cuts the triangle left, and
+    # OpenSCAD closes the face with the merged corner's own triangle: the diagonal
+    # runs through the corner kept
+    same = (s == s[:, nxt]) & (t == t[:, nxt])
+    distinct = ~((s[:, 0] == s[:, 2]) & (t[:, 0] == t[:, 2])) & \
+        ~((s[:, 1] == s[:, 3]) & (t[:, 1] == t[:, 3]))
+    merged = np.isfinite(norm).all(axis=1) & (absn.max(axis=1) > 0) & \
+        (same.sum(axis=1) == 1) & distinct
+    first = np.argmax(same, axis=1)
+    kept = np.where(first == 0, 1, first)                 # in OpenSCAD's (reversed) order
+    out[merged] = ((kept + 1) % 2)[merged]
+    # two opposite corners on one point: a projection of no area, libtess2 cuts nothing
+    # and OpenSCAD closes the whole loop itself, as it does a bow tie's
+    pinched = np.isfinite(norm).all(axis=1) & (absn.max(axis=1) > 0) & \
+        ~same.any(axis=1) & ~distinct
+    if corner_ids is not None and pinched.any():
+        ids = np.asarray(corner_ids, dtype=np.int64).reshape(-1, 4)[pinched]
+        out[pinched] = _bow_tie_diagonals(ids[:, ::-1])
     return out
 
 

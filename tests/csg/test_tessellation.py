@@ -63,26 +63,54 @@ def test_the_bent_polyhedron_voxelizes_as_openscads_stl():
     assert vox.count <= 1.002 * stl.count
 
 
-def test_a_quad_of_unknown_cut_keeps_both_diagonals_as_surface():
-    # OpenSCAD's test model issue964: face [2, 3, 6, 5] projects (along z, off
-    # libtess2's normal) with two corners on one point; its cut is not repeated here,
-    # and both count as surface
+def test_issue964_is_cut_as_openscads_stl_and_unknown_cuts_keep_both_diagonals():
+    # OpenSCAD's test model issue964: face [2, 3, 6, 5] has a tie in libtess2's normal
+    # (projected along y, it is a proper quad); face [3, 0, 6, 5] projects along z with two
+    # corners on one point; 1-5, 3-6 and 0-4 are cut through a spike at a corner
     points = np.array([[0, 0, 0], [10, 0, 0], [10, 10, 0], [0, 10, 0], [0, -20, 20],
                        [10, -20, 20], [10, -20, 30], [0, -20, 30]], dtype=float)
     faces = [[0, 1, 2, 3], [4, 5, 6, 7], [1, 2, 5, 4], [2, 3, 6, 5], [3, 0, 6, 5],
              [0, 1, 4, 7]]
     ids = openscad_vertex_ids(points, faces)[np.array(faces)]
-    # the others as OpenSCAD 2021.01's STL of issue964 cuts them (1-5, 3-6 and 0-4 through
-    # a spike at a corner, the planar ones either way)
-    assert quad_diagonals(points[np.array(faces)], ids).tolist() == [0, 1, 0, -1, 0, 0]
+    # as OpenSCAD 2021.01's STL of issue964 cuts them (the planar ones either way)
+    assert quad_diagonals(points[np.array(faces)], ids).tolist() == [0, 1, 0, 1, 0, 0]
     solid = csg.read_openscad(f"polyhedron(points = {points.tolist()}, faces = {faces});")
-    assert len(solid.alternative_faces) == 4
+    assert len(solid.alternative_faces) == 0
     # a face listing a corner twice in a row is that quad, numbered alike
     again = csg.read_openscad(f"polyhedron(points = {points.tolist()}, "
                               f"faces = {faces[:3] + [[2, 3, 3, 6, 5]] + faces[4:]});")
     assert np.array_equal(again.faces, solid.faces)
-    vox = iv.voxelize(solid, 48, workers=1)
+    # a quad of no normal (its corners on a line) is not known: both cuts count as surface
+    line = np.array([[0, 0, 0], [1, 1, 1], [2, 2, 2], [3, 3, 3]], dtype=float)
+    assert quad_diagonals(line[None]).tolist() == [-1]
+    flat = csg.read_openscad(f"polyhedron(points = {points.tolist()}, faces = {faces});",
+                             facets="openscad")
+    kept = csg.Polyhedron(flat.vertices, flat.faces,
+                          alternative_faces=[[2, 3, 6], [2, 6, 5]])
+    vox = iv.voxelize(kept, 48, workers=1)
     quad = points[[2, 3, 6, 5]]
     for tri in [(0, 1, 2), (0, 2, 3), (0, 1, 3), (1, 2, 3)]:     # either cut of the quad
         w = np.random.default_rng(sum(tri)).dirichlet(np.ones(3), 300)
         assert misses(vox, w @ quad[list(tri)]) == 0, tri
+
+
+def test_quads_pinched_in_libtess2s_projection_are_cut_as_openscad_cuts_them():
+    """tests/openscad/pinched.scad: 200 quads with two corners (neighbours or opposite) on
+    one point of libtess2's projection (neighbours merge, the diagonal runs through the
+    corner kept; opposite corners leave no area, and OpenSCAD closes the loop itself) and
+    80 generic quads, point numbers shuffled: every diagonal is the one in OpenSCAD's STL."""
+    text = (FIXTURES / "pinched.scad").read_text()
+    points = np.array(eval(re.search(r"points = (\[.*?\]\]),", text, re.S).group(1)))
+    faces = eval(re.search(r"faces = (\[.*?\]\])\)", text, re.S).group(1))
+    quads = np.array(faces)
+    diagonal = quad_diagonals(points[quads], openscad_vertex_ids(points, faces)[quads])
+    assert (diagonal >= 0).all()
+    assert 40 <= (diagonal == 1).sum() <= len(quads) - 40
+    v, f = as_triangles(str(FIXTURES / "pinched.stl"))
+    index = np.linalg.norm(v[:, None] - points[None], axis=2).argmin(axis=1)[f]
+    per_face = {}
+    for t in index:
+        per_face.setdefault(int(np.flatnonzero((quads == t[0]).any(axis=1))[0]), []).append(t)
+    for k, quad in enumerate(quads):
+        cut = set(per_face[k][0].tolist()) & set(per_face[k][1].tolist())
+        assert cut == set(quad[[0, 2]] if diagonal[k] == 0 else quad[[1, 3]]), k
