@@ -55,7 +55,8 @@ from .tape import Tape, Value, allocate
 
 __all__ = ["TapePool", "prune_tape", "TAPE", "START", "ROWS", "ROOT", "OUTPUT", "REGISTERS",
            "ROW", "OP", "OUT", "ARG_A", "ARG_B", "ARG_C", "MASK", "MASK_A",
-           "MASK_B", "MASK_C", "VALUE", "VALUE_A", "VALUE_B", "VALUE_C", "AXIS_MASKS"]
+           "MASK_B", "MASK_C", "VALUE", "VALUE_A", "VALUE_B", "VALUE_C", "AXIS_MASKS",
+           "INITIAL_ROWS", "INITIAL_TAPES"]
 
 #: the columns of a row (int32)
 ROW = 13
@@ -73,6 +74,9 @@ START, ROWS, ROOT, OUTPUT, REGISTERS = range(TAPE)
 (USED_ROWS, USED_TAPES, USED_KEYS, USED_DERIVATIONS, USED_CONTENTS, FULL) = range(6)
 #: the axis masks of the inputs x, y, z
 AXIS_MASKS = {"x": 1, "y": 2, "z": 4}
+#: a new pool's room: rows (besides the base tape's) and tapes (powers of 2)
+INITIAL_ROWS = 1 << 12
+INITIAL_TAPES = 1 << 8
 _NEG_OP = OPCODES["neg"]
 
 
@@ -87,11 +91,15 @@ class TapePool:
     tape : Tape
         The base tape (without sweeps: :func:`implicitvox.eval.compiled.encode`
         must take it).
-    rows, tapes : int
-        Initial capacity (zeroed pages: the memory is taken as they are written).
+    rows, tapes : int, optional
+        Initial capacity; :meth:`grow` doubles it as the runs need. Small by default
+        (:data:`INITIAL_ROWS`, :data:`INITIAL_TAPES`): where the kernel backs memory
+        with huge pages, the first write into a zeroed page clears 2 MiB, and the hash
+        tables' scattered probes into a roomy pool cleared some 100 MB per run (40 ms
+        for a cube).
     """
 
-    def __init__(self, tape: Tape, rows: int = 1 << 20, tapes: int = 1 << 16):
+    def __init__(self, tape: Tape, rows: int = INITIAL_ROWS, tapes: int = INITIAL_TAPES):
         if not tape.branches:           # nothing to prune: the base tape alone
             rows, tapes = len(tape), 1
         compiled = encode(tape)
