@@ -177,16 +177,15 @@ class TapePool:
         doubled until they fit; the hash tables kept at most half full). Call
         between runs."""
         used = self.used
-        while used[USED_ROWS] + rows > len(self.rows):
-            self.rows = _doubled(self.rows)
-        while used[USED_TAPES] + tapes > len(self.tapes):
-            self.tapes = _doubled(self.tapes)
-        while used[USED_KEYS] + rows > len(self.keys):
-            self.keys = _doubled(self.keys)
-        while (used[USED_DERIVATIONS] + tapes) * 2 > len(self.derivations):
-            self.derivations = _rehashed(self.derivations, 2 * len(self.derivations))
-        while (used[USED_CONTENTS] + tapes) * 2 > len(self.contents):
-            self.contents = _rehashed(self.contents, 2 * len(self.contents))
+        self.rows = _grown(self.rows, used[USED_ROWS] + rows)
+        self.tapes = _grown(self.tapes, used[USED_TAPES] + tapes)
+        self.keys = _grown(self.keys, used[USED_KEYS] + rows)
+        room = _doublings(len(self.derivations), 2 * (used[USED_DERIVATIONS] + tapes))
+        if room > len(self.derivations):
+            self.derivations = _rehashed(self.derivations, room)
+        room = _doublings(len(self.contents), 2 * (used[USED_CONTENTS] + tapes))
+        if room > len(self.contents):
+            self.contents = _rehashed(self.contents, room)
         used[FULL] = 0
 
     def __getstate__(self) -> dict:
@@ -256,8 +255,20 @@ class TapePool:
         return built
 
 
-def _doubled(a: np.ndarray) -> np.ndarray:
-    out = np.zeros((2 * len(a),) + a.shape[1:], dtype=a.dtype)
+def _doublings(length: int, needed: int) -> int:
+    """``length`` doubled until it holds ``needed`` (``length`` itself if it does)."""
+    length = max(int(length), 1)
+    while length < needed:
+        length *= 2
+    return length
+
+
+def _grown(a: np.ndarray, needed: int) -> np.ndarray:
+    """``a``, or a copy doubled (at once, as often as it takes) to hold ``needed`` rows."""
+    length = _doublings(len(a), needed)
+    if length == len(a):
+        return a
+    out = np.zeros((length,) + a.shape[1:], dtype=a.dtype)
     out[:len(a)] = a
     return out
 

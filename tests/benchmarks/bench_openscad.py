@@ -35,7 +35,8 @@ For every ``/usr/share/openscad/examples/**/*.scad``:
    lattice reaching that far past its bounds, where a true circle bulges beyond its
    inscribed polygon). ``ratio`` is output voxels over STL voxels.
 
-Each model runs in a child process with a timeout. Writes the table
+Each model runs in a child process with a timeout; Numba's on-disk cache is filled
+first (:func:`_warm_up`, untimed), so no model carries the kernels' one-time compile. Writes the table
 ``openscad`` (the note of issue 17 quotes it). ``--constructs``: the same for
 one small model per construct (:data:`CONSTRUCTS`), the table
 ``openscad-constructs``. ``--tests``: the same for OpenSCAD's own test models
@@ -336,6 +337,29 @@ def _cell(row: dict, key: str, fmt: str = "{}") -> str:
     return fmt.format(row[key]) if key in row else "-"
 
 
+#: a small model through every compiled path the models take (see :func:`_warm_up`)
+WARM_UP = """
+difference() {
+  union() { cube(10); sphere(r = 6, $fn = 12); cylinder(h = 12, r = 3, $fn = 10); }
+  polyhedron(points = [[2, 2, 2], [9, 3, 2], [4, 9, 3], [5, 5, 11]],
+             faces = [[0, 2, 1], [0, 1, 3], [1, 2, 3], [0, 3, 2]]);
+  linear_extrude(height = 20, twist = 30) square(3);
+}
+"""
+
+
+def _warm_up() -> None:
+    """Fill Numba's on-disk cache before any model is timed (a fresh checkout compiles
+    each kernel once, about half a minute in all: an install's one-time cost, which
+    the first model would otherwise carry)."""
+    import csg
+    import implicitvox as iv
+    csg.read_openscad(WARM_UP).voxelize(resolution=32, workers=1)
+    corners = np.array([[0.0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]])
+    faces = np.array([[0, 2, 1], [0, 1, 3], [1, 2, 3], [0, 3, 2]])
+    iv.voxelize_mesh((corners, faces), 32, workers=1)
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--resolution", type=int, default=128)
@@ -352,6 +376,7 @@ def main() -> None:
                                args.child[3], float(args.child[4]))))
         return
     load = tables.load_average()
+    _warm_up()
     root, cache, table = EXAMPLES, CACHE, "openscad"
     if args.constructs:
         root, cache, table = _write_constructs(), CACHE / "constructs-out", "openscad-constructs"
