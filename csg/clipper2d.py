@@ -31,7 +31,7 @@ True
 from __future__ import annotations
 
 import math
-from typing import Any, Optional
+from typing import Any, Optional, Sequence
 
 import numpy as np
 
@@ -40,6 +40,7 @@ from .protocol import NotFlat, fold
 from .solid import Solid
 
 __all__ = ["region_paths", "boolean_paths", "region_pieces", "simple_pieces", "offset",
+           "minkowski",
            "to_polygon", "clip",
            "to_clipper", "check_range", "OutOfRange", "CLIPPER_SCALE", "CLIPPER_RANGE",
            "MITER_LIMIT", "NotFlat"]
@@ -218,6 +219,66 @@ def to_polygon(paths: list) -> Optional[Polygon]:
     tree of outlines: rings touching at a vertex stay apart), or None."""
     pieces = _tree_pieces(paths)
     return pieces_polygon(pieces) if pieces else None
+
+
+def minkowski(solids: Sequence[Solid]) -> Optional[Polygon]:
+    """OpenSCAD's 2D ``minkowski()`` of 2D trees (``ClipperUtils::applyMinkowski``), on
+    its integers: per pair of outlines, the quads that sum each edge of one with each
+    edge of the other (``minkowski_outline``), then each operand moved to the first
+    point of every positive outline of the other (``fill_minkowski_insides``: the
+    sums of the interiors), united non-zero; from the third operand on, the sum so far
+    is the first. Exact for outlines of any shape, holes and separate parts included
+    (a sum point ``a + b`` lies on an edge sum where both ``a`` and ``b`` can be moved
+    to their outlines, else in one operand moved by a point of the other's part).
+
+    >>> from csg import Rectangle, Union
+    >>> ell = Union(Rectangle((4, 1)), Rectangle((1, 4)))         # not convex
+    >>> minkowski([ell, Rectangle((1, 1))]).bounds
+    ((0.0, 0.0, 0.0), (5.0, 5.0, 0.0))
+    """
+    lhs = region_paths(solids[0])
+    for solid in solids[1:]:
+        rhs = region_paths(solid)
+        terms = []
+        for r in rhs:
+            for path in lhs:
+                terms.extend(_edge_sums(path, r))
+        terms.extend(_moved_into(lhs, rhs))
+        terms.extend(_moved_into(rhs, lhs))
+        lhs = clip(terms, [], "CT_UNION")
+    return to_polygon(lhs)
+
+
+def _edge_sums(poly: list, path: list) -> list:
+    """``minkowski_outline(poly, path, sum, closed)``: the quads
+    ``path[i] + poly[j], path[i + 1] + poly[j], path[i + 1] + poly[j + 1],
+    path[i] + poly[j + 1]``, each turned counter-clockwise (Clipper's
+    ``Orientation``: area at least 0)."""
+    a = np.asarray(poly, dtype=np.int64)
+    b = np.asarray(path, dtype=np.int64)
+    pp = b[:, None, :] + a[None, :, :]                        # (path, poly, 2)
+    nxt_i = np.roll(np.arange(len(b)), -1)
+    nxt_j = np.roll(np.arange(len(a)), -1)
+    quads = np.stack([pp, pp[nxt_i], pp[nxt_i][:, nxt_j], pp[:, nxt_j]], axis=2).reshape(-1, 4, 2)
+    if np.abs(quads).max(initial=0) >= 1 << 29:               # exact areas as Python ints
+        quads = quads.astype(object)
+    x, y = quads[:, :, 0], quads[:, :, 1]
+    twice_area = (x * np.roll(y, -1, axis=1) - np.roll(x, -1, axis=1) * y).sum(axis=1)
+    backward = np.asarray(twice_area < 0, dtype=bool)
+    quads[backward] = quads[backward][:, ::-1]
+    return quads.astype(np.int64).tolist()
+
+
+def _moved_into(a: list, b: list) -> list:
+    """``fill_minkowski_insides(a, b)``: every outline of ``a`` moved to the first point
+    of each positive (counter-clockwise) outline of ``b``."""
+    import pyclipper
+    out = []
+    for path in b:
+        if path and pyclipper.Orientation(path):
+            dx, dy = path[0]
+            out.extend([[(x + dx, y + dy) for x, y in outline] for outline in a])
+    return out
 
 
 def offset(solid: Solid, delta: float, join: str = "round", fragments: Optional[int] = None

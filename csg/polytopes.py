@@ -36,6 +36,7 @@ from typing import Any, NamedTuple
 import numpy as np
 
 from .clipper2d import CLIPPER_SCALE, region_paths
+from .clipper2d import minkowski as clipper_minkowski
 from .planar import Polygon
 from .primitives import ConvexPolyhedron, Polyhedron
 from .protocol import NotAMesh, NotAPolytope, NotFlat, fold
@@ -232,17 +233,37 @@ def minkowski(*solids: Solid) -> Solid:
     meshes, ``M ⊕ N = ⋃ (N + t) ∪ ⋃ (M + s) ∪ ⋃ (T ⊕ S)`` over their triangles
     ``T ∋ t`` and ``S ∋ s``. The same point set as OpenSCAD's union over the convex
     parts of its decomposition (CGAL's ``convex_decomposition_3``), whatever those
-    parts are. A 2D piece must be convex.
+    parts are. Where a 2D piece is not convex (a concave polygon, a difference), the
+    sum is OpenSCAD's own (:func:`csg.clipper2d.minkowski`: edge sums and moved
+    operands, united by Clipper on OpenSCAD's integer grid).
 
     Raises
     ------
     NotAPolytope
-        An operand has a curved piece, or a 2D piece that is not convex.
+        An operand has a curved piece.
     ValueError
         The sum would have more than :data:`MAX_PIECES` pieces or
         :data:`MAX_SUMS` vertex sums.
     """
-    _same_dim(solids, "minkowski")
+    if _same_dim(solids, "minkowski") == 2:
+        errors = []
+        for solid in solids:
+            try:
+                _pieces(solid, np.eye(4), True)
+            except NotAPolytope as err:
+                errors.append(err)
+        for err in errors:
+            if err.curved or err.empty:
+                raise err
+        if errors:
+            # a piece that is not convex: OpenSCAD's own 2D sum, on its integers
+            try:
+                region = clipper_minkowski(solids)
+            except NotFlat as err:            # a curved leaf beside the concave piece
+                raise NotAPolytope(str(err), curved=True) from None
+            if region is None:
+                raise ValueError("minkowski: the sum spans no area")
+            return region
     sums = _pieces(solids[0], np.eye(4), True, meshes=True)
     for solid in solids[1:]:
         pieces = _pieces(solid, np.eye(4), True, meshes=True)
