@@ -15,7 +15,8 @@ where it enters. Each test is a sign of exact predicates
 
 Only the triangles whose shadow's box holds ``(p_y, p_z)`` are tested (a
 uniform grid on the ``yz`` plane), so a query costs a few tests, not one per
-triangle. For open meshes use the generalized winding number
+triangle; the tests run compiled (:mod:`implicitvox.triangles.crossing_kernels`,
+floating-point filters), the pairs they cannot certify on the exact array path. For open meshes use the generalized winding number
 (:mod:`implicitvox.triangles.winding`) instead.
 
 Examples
@@ -97,6 +98,21 @@ class RayWinding:
         q = p[pts]
         near = np.all((t.lo[tri][:, 1:] <= q[:, 1:]) & (t.hi[tri][:, 1:] >= q[:, 1:]), axis=1)
         pts, tri, q = pts[near], tri[near], q[near]
+        from .crossing_kernels import crossing_pairs     # (loads Numba: not at import)
+        from .tribox_kernels import UNSURE
+        crossing = crossing_pairs(t, tri, q).astype(np.int64)
+        unsure = np.flatnonzero(crossing == UNSURE)
+        if len(unsure):
+            crossing[unsure] = self.crossings_by_arrays(tri[unsure], q[unsure])
+        np.add.at(out, pts, crossing)
+        return out
+
+    def crossings_by_arrays(self, tri: np.ndarray, q: np.ndarray) -> np.ndarray:
+        """The signed crossings (``normal_sign[tri, 0]`` or 0) of the rays from ``q``
+        (m, 3) along ``+x`` with triangles ``tri``, over whole arrays, every sign
+        exact: the path for the pairs the compiled filter leaves unsure, and the
+        oracle the tests hold it to."""
+        t = self.tris
         sx = t.normal_sign[tri, 0].astype(np.int64)
         v = t.v[tri]
         inside = np.ones(len(tri), dtype=bool)
@@ -110,9 +126,7 @@ class RayWinding:
             s = np.where(s == 0, tie, s)
             inside &= s == sx
         ahead = orient3d_sign(v[:, 0], v[:, 1], v[:, 2], q).astype(np.int64) == -sx
-        hit = inside & ahead
-        np.add.at(out, pts[hit], sx[hit])
-        return out
+        return np.where(inside & ahead, sx, 0)
 
 
 def face_groups(lo: np.ndarray, hi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -45,7 +45,8 @@ from .pairs import sorted_unique
 from .ranges import buckets, expand_boxes, gather, grid_cells
 from .tribox import Triangles
 
-__all__ = ["MeshClassifier", "BoxMemory", "edges_shared", "forget_decided", "LISTED", "OFF"]
+__all__ = ["MeshClassifier", "BoxMemory", "edges_shared", "edges_balanced", "forget_decided",
+           "LISTED", "OFF"]
 
 #: a remembered box's ``single`` when it holds no one triangle: its triangles are
 #: listed (LISTED), or none meets it and ``above`` holds its winding number (OFF)
@@ -66,6 +67,26 @@ def edges_shared(vertices: np.ndarray, faces: np.ndarray) -> bool:
     _, count = np.unique(lo.astype(np.int64) * (int(point.max(initial=0)) + 1) + hi,
                          return_counts=True)
     return bool(np.all(count >= 2))
+
+
+def edges_balanced(vertices: np.ndarray, faces: np.ndarray) -> bool:
+    """Whether every edge (vertices merged by their coordinates) is run as often from
+    one end to the other as back by the faces: the oriented surface has no boundary,
+    so the count of the triangles a ray crosses, signed, is the same for every ray
+    from a point (its winding number)."""
+    v = np.asarray(vertices, dtype=np.float64)[np.asarray(faces)].reshape(-1, 3) + 0.0
+    _, point = np.unique(v, axis=0, return_inverse=True)
+    point = point.reshape(-1, 3).astype(np.int64)
+    a = point.ravel()
+    b = np.roll(point, -1, axis=1).ravel()
+    real = a != b
+    a, b = a[real], b[real]
+    n = int(point.max(initial=0)) + 1
+    key = np.minimum(a, b) * n + np.maximum(a, b)
+    keys, index = np.unique(key, return_inverse=True)
+    balance = np.zeros(len(keys), dtype=np.int64)
+    np.add.at(balance, index, np.where(a < b, 1, -1))
+    return bool(np.all(balance == 0))
 
 
 class BoxMemory:
@@ -176,6 +197,8 @@ class MeshClassifier:
         self.winding = RayWinding(self.tris)
         #: closed (every edge shared): a box met by one triangle is cut by its plane
         self.closed = edges_shared(vertices, faces)
+        #: oriented and closed (a cycle): its ray counts are its winding numbers
+        self.oriented = self.closed and edges_balanced(vertices, faces)
         self.lo = self.tris.lo.min(axis=0)
         self.hi = self.tris.hi.max(axis=0)
         n = len(self.tris)
@@ -278,17 +301,36 @@ class MeshClassifier:
 
     def _sides(self, t: np.ndarray, lo: np.ndarray, hi: np.ndarray):
         """Winding numbers of the parts of boxes ``[lo, hi]`` strictly above and below
-        the plane of their one triangle ``t``: at the box corner greatest (least)
-        along the normal, where that corner is off the plane (else no sub-box lies
-        on that side, and 0 is never read)."""
+        the plane of their one triangle ``t``: one ray query per box, at the corner
+        greatest along the normal where it is off the plane (else at the least, and
+        then nothing lies above: that side is never read). The other side differs
+        by one: a segment between the two sides inside the box crosses ``t`` alone,
+        once, and the winding number gains 1 across a triangle against its normal
+        (``+x`` rays cross a triangle facing ``+x`` from behind it; a triangle facing
+        ``-x``, from in front of it, counts ``-1``). That needs the ray counts to be
+        a winding number: a mesh whose every edge is crossed as often one way as the
+        other (:func:`edges_balanced`); on others both sides are asked."""
         positive = self.tris.normal_sign[t] >= 0
+        top = np.where(positive, hi, lo)
+        bottom = np.where(positive, lo, hi)
         above = np.zeros(len(t), dtype=np.int64)
         below = np.zeros(len(t), dtype=np.int64)
-        for corner, want, out in ((np.where(positive, hi, lo), 1, above),
-                                  (np.where(positive, lo, hi), -1, below)):
-            strict = np.flatnonzero(self.tris.planes.sign(t, corner) == want)
-            if len(strict):
-                out[strict] = self.winding(corner[strict])
+        if not self.oriented:           # ray counts that are no winding number: ask both
+            for corner, want, out in ((top, 1, above), (bottom, -1, below)):
+                strict = np.flatnonzero(self.tris.planes.sign(t, corner) == want)
+                if len(strict):
+                    out[strict] = self.winding(corner[strict])
+            return above, below
+        up = self.tris.planes.sign(t, top) == 1
+        ask = np.flatnonzero(up)
+        if len(ask):
+            above[ask] = self.winding(top[ask])
+            below[ask] = above[ask] + 1
+        rest = np.flatnonzero(~up)
+        if len(rest):
+            rest = rest[self.tris.planes.sign(t[rest], bottom[rest]) == -1]
+            below[rest] = self.winding(bottom[rest])
+            above[rest] = below[rest] - 1
         return above, below
 
     def _pairs(self, boxes: np.ndarray, lo: np.ndarray, hi: np.ndarray):

@@ -5,11 +5,14 @@ array path - the same axes, the same determinants, the same floating-point
 filters (Shewchuk's a-priori bounds ``4e`` for ``det2`` and ``8e`` for
 ``orient3d``, see :mod:`implicitvox.triangles.predicates`) - in one compiled
 loop, with no array per stage. Where a filter cannot certify a sign, the
-pair's answer is :data:`UNSURE` and the caller settles it on the exact path
-(Python integers); every answer given here is the exact one, so the result is
-the array path's, bit for bit.
+sign is computed exactly in floating-point expansions
+(:mod:`implicitvox.triangles.expansions`: exact where the coordinates'
+differences are, as on a lattice: the ties of round models on round grids);
+where that cannot be done either, the pair's answer is :data:`UNSURE` and the
+caller settles it on the exact path (Python integers). Every answer given here
+is the exact one, so the result is the array path's, bit for bit.
 
-Two exact rules spare the integer path its most frequent visitors, products
+Two exact rules spare the later stages their most frequent visitors, products
 that are zero for axis-aligned input (a cube's faces on a voxel grid):
 
 * ``det2``: a product with a factor that is exactly zero (a float difference
@@ -26,9 +29,10 @@ Examples
 >>> t = Triangles(np.array([[[0.0, 0, 0], [1, 0, 0], [0, 1, 0]]]))
 >>> lo = np.array([[0.2, 0.2, -1.0], [0.51, 0.5, -1.0], [0.5, 0.5, -1.0]])
 >>> meet_pairs(t, np.array([0, 0, 0]), lo, lo + 1.0).tolist()   # meets, misses, touches
-[1, 0, 2]
->>> t.meet_boxes(np.array([0, 0, 0]), lo, lo + 1.0).tolist()   # the tie settled exactly
-[True, False, True]
+[1, 0, 1]
+>>> tiny = Triangles(t.v * 2.0 ** -1000)         # products underflow: the exact path's
+>>> meet_pairs(tiny, np.array([0]), lo[2:] * 2.0 ** -1000, (lo[2:] + 1) * 2.0 ** -1000)
+array([2], dtype=int8)
 """
 from __future__ import annotations
 
@@ -36,11 +40,11 @@ import numpy as np
 from numba import njit
 
 from ..interval.rules import COMPILE
+from .expansions import UNSURE, det2_exact, orient3d_exact
 
-__all__ = ["UNSURE", "meet_pair", "meet_pairs", "meet_any_pairs", "plane_side_pairs"]
+__all__ = ["UNSURE", "det2_filtered", "plane_filtered", "meet_pair", "meet_pairs",
+           "meet_any_pairs", "plane_side_pairs"]
 
-#: a pair whose answer needs the exact path
-UNSURE = 2
 
 _EPS = 2.0 ** -53
 _DET2_BOUND = 4.0 * _EPS
@@ -52,7 +56,7 @@ _INF = np.inf
 
 
 @njit(**COMPILE)
-def _det2(a0, a1, b0, b1, p0, p1, q0, q1):
+def det2_filtered(a0, a1, b0, b1, p0, p1, q0, q1):
     """Sign of ``(b0 - a0)(q1 - p1) - (b1 - a1)(q0 - p0)``, or UNSURE."""
     f0 = b0 - a0
     f1 = b1 - a1
@@ -66,42 +70,43 @@ def _det2(a0, a1, b0, b1, p0, p1, q0, q1):
     bound = _DET2_BOUND * (abs(left) + abs(right))
     if abs(det) > bound and bound > _TINY and bound < _INF:
         return 1 if det > 0.0 else -1
-    return UNSURE
+    return det2_exact(a0, a1, b0, b1, p0, p1, q0, q1)
 
 
 @njit(inline="always", **COMPILE)
-def _plane(planes, t, d0, d1, d2):
-    """Sign of ``orient3d`` of triangle ``t``'s plane against point ``d``, or UNSURE
-    (``planes``: the rows of :attr:`implicitvox.triangles.predicates.FixedPlanes.rows`)."""
+def plane_filtered(v, planes, t, d0, d1, d2):
+    """Sign of ``orient3d`` of triangle ``t`` (corners ``v[t]``) against point ``d``,
+    or UNSURE (``planes``: the rows of
+    :attr:`implicitvox.triangles.predicates.FixedPlanes.rows`)."""
     dx = d0 - planes[t, 0]
     dy = d1 - planes[t, 1]
     dz = d2 - planes[t, 2]
     n0, n1, n2 = planes[t, 3], planes[t, 4], planes[t, 5]
     w0, w1, w2 = planes[t, 6], planes[t, 7], planes[t, 8]
-    if planes[t, 9] == 0.0:
-        return UNSURE
-    if (w0 == 0.0 or dx == 0.0) and (w1 == 0.0 or dy == 0.0) and (w2 == 0.0 or dz == 0.0):
-        return 0
-    det = n0 * dx + n1 * dy + n2 * dz
-    bound = _DET3_BOUND * (w0 * abs(dx) + w1 * abs(dy) + w2 * abs(dz))
-    if abs(det) > bound and bound > _TINY and bound < _INF:
-        return 1 if det > 0.0 else -1
-    return UNSURE
+    if planes[t, 9] != 0.0:
+        if (w0 == 0.0 or dx == 0.0) and (w1 == 0.0 or dy == 0.0) and (w2 == 0.0 or dz == 0.0):
+            return 0
+        det = n0 * dx + n1 * dy + n2 * dz
+        bound = _DET3_BOUND * (w0 * abs(dx) + w1 * abs(dy) + w2 * abs(dz))
+        if abs(det) > bound and bound > _TINY and bound < _INF:
+            return 1 if det > 0.0 else -1
+    return orient3d_exact(v[t, 0, 0], v[t, 0, 1], v[t, 0, 2], v[t, 1, 0], v[t, 1, 1],
+                          v[t, 1, 2], v[t, 2, 0], v[t, 2, 1], v[t, 2, 2], d0, d1, d2)
 
 
 @njit(inline="always", **COMPILE)
-def _side(planes, normal_sign, t, lo, hi, k):
+def _side(v, planes, normal_sign, t, lo, hi, k):
     """:meth:`Triangles.plane_sides` of pair ``k``: 1, -1, 0, or UNSURE."""
     p0 = normal_sign[t, 0] >= 0
     p1 = normal_sign[t, 1] >= 0
     p2 = normal_sign[t, 2] >= 0
-    s = _plane(planes, t, lo[k, 0] if p0 else hi[k, 0], lo[k, 1] if p1 else hi[k, 1],
+    s = plane_filtered(v, planes, t, lo[k, 0] if p0 else hi[k, 0], lo[k, 1] if p1 else hi[k, 1],
                lo[k, 2] if p2 else hi[k, 2])
     if s == UNSURE:
         return UNSURE
     if s > 0:
         return 1
-    s = _plane(planes, t, hi[k, 0] if p0 else lo[k, 0], hi[k, 1] if p1 else lo[k, 1],
+    s = plane_filtered(v, planes, t, hi[k, 0] if p0 else lo[k, 0], hi[k, 1] if p1 else lo[k, 1],
                hi[k, 2] if p2 else lo[k, 2])
     if s == UNSURE:
         return UNSURE
@@ -120,7 +125,7 @@ def _shadow_inside(v, t, n, lo, hi, k, j, l):
         up_j = bl - al > 0.0
         q_l = lo[k, l] if up_l == (n > 0) else hi[k, l]
         q_j = lo[k, j] if up_j != (n > 0) else hi[k, j]
-        s = _det2(aj, al, bj, bl, aj, al, q_j, q_l)
+        s = det2_filtered(aj, al, bj, bl, aj, al, q_j, q_l)
         if s == UNSURE or (s < 0 if n > 0 else s > 0):
             return False
     return True
@@ -137,9 +142,9 @@ def _edge_axis(aj, al, bj, bl, wj, wl, n, loj, lol, hij, hil):
     q_l = lol if up_l else hil
     q_j = hij if up_j else loj
     if n > 0:
-        s = _det2(aj, al, bj, bl, wj, wl, q_j, q_l)
+        s = det2_filtered(aj, al, bj, bl, wj, wl, q_j, q_l)
     else:
-        s = _det2(aj, al, bj, bl, aj, al, q_j, q_l)
+        s = det2_filtered(aj, al, bj, bl, aj, al, q_j, q_l)
     if s == UNSURE:
         sure = False
     elif s > 0:
@@ -149,9 +154,9 @@ def _edge_axis(aj, al, bj, bl, wj, wl, n, loj, lol, hij, hil):
     q_l = hil if up_l else lol
     q_j = loj if up_j else hij
     if n < 0:
-        s = _det2(aj, al, bj, bl, wj, wl, q_j, q_l)
+        s = det2_filtered(aj, al, bj, bl, wj, wl, q_j, q_l)
     else:
-        s = _det2(aj, al, bj, bl, aj, al, q_j, q_l)
+        s = det2_filtered(aj, al, bj, bl, aj, al, q_j, q_l)
     if s == UNSURE:
         return UNSURE
     if s < 0:
@@ -207,7 +212,7 @@ def meet_pair(v, tlo, thi, normal_sign, axis, planes, t, lo, hi, glo, ghi, k):
         if (glo[k, 0] <= v[t, c, 0] <= ghi[k, 0] and glo[k, 1] <= v[t, c, 1] <= ghi[k, 1]
                 and glo[k, 2] <= v[t, c, 2] <= ghi[k, 2]):
             return 1
-    side = _side(planes, normal_sign, t, glo, ghi, k)
+    side = _side(v, planes, normal_sign, t, glo, ghi, k)
     if side == 1 or side == -1:
         return 0
     if side == 0 and axis[t] >= 0:
@@ -242,9 +247,9 @@ def _meet_any_kernel(v, tlo, thi, normal_sign, axis, planes, tri, lo, hi, glo, g
 
 
 @njit(**COMPILE)
-def _side_kernel(planes, normal_sign, tri, lo, hi, out):
+def _side_kernel(v, planes, normal_sign, tri, lo, hi, out):
     for k in range(tri.size):
-        out[k] = _side(planes, normal_sign, tri[k], lo, hi, k)
+        out[k] = _side(v, planes, normal_sign, tri[k], lo, hi, k)
 
 
 def _kernel_arguments(triangles, tri, lo, hi) -> tuple:
@@ -312,7 +317,7 @@ def plane_side_pairs(triangles, tri: np.ndarray, lo: np.ndarray, hi: np.ndarray)
     tri = np.ascontiguousarray(tri, dtype=np.int64)
     out = np.empty(len(tri), dtype=np.int8)
     if len(tri):
-        _side_kernel(triangles.planes.rows, triangles.normal_sign, tri,
+        _side_kernel(triangles.v, triangles.planes.rows, triangles.normal_sign, tri,
                      np.ascontiguousarray(lo, dtype=np.float64),
                      np.ascontiguousarray(hi, dtype=np.float64), out)
     return out

@@ -15,7 +15,8 @@ import pyvista as pv
 
 import implicitvox as ivx
 from csg import Box, Polyhedron, Sphere
-from implicitvox.triangles.mesh_classifier import OFF, BoxMemory, MeshClassifier, edges_shared, forget_decided
+from implicitvox.triangles.mesh_classifier import (OFF, BoxMemory, MeshClassifier, edges_balanced,
+                                                   edges_shared, forget_decided)
 from implicitvox.expr.shape import Octants, takes_octants
 from implicitvox.octree.grid import grid_of
 from implicitvox.octree.subdivide import subdivide
@@ -34,6 +35,12 @@ def _two_shells():
     """Two overlapping closed cubes as one mesh: winding number 2 where they overlap."""
     (v1, f1), (v2, f2) = _cube((0, 0, 0), 1.0), _cube((0.37, 0.21, 0.13), 1.0)
     return np.concatenate([v1, v2]), np.concatenate([f1, f2 + len(v1)])
+
+
+def _turned(faces: np.ndarray, k: int = 3) -> np.ndarray:
+    faces = faces.copy()
+    faces[k] = faces[k, ::-1]
+    return faces
 
 
 def _plain(test):
@@ -66,6 +73,9 @@ SOLIDS = {
     # its states are the cold test's, whatever they mean
     "open shells": (lambda: Polyhedron(_two_shells()[0], np.delete(_two_shells()[1], [2, 3], 0)),
                     None),
+    # closed but not oriented (one triangle turned over): its ray counts are no winding
+    # number, so both sides of a one-triangle box are asked, not one and the other by +-1
+    "turned triangle": (lambda: Polyhedron(_cube()[0], _turned(_cube()[1])), None),
     # a lattice the cube's faces lie on: boxes touch faces, edges and corners exactly
     "cube on the lattice": (lambda: Polyhedron(_cube(size=1.0)), ((-1, -1, -1), (1, 1, 1))),
 }
@@ -98,6 +108,14 @@ def test_edges_shared_tells_closed_from_open_meshes():
     assert edges_shared(*_two_shells())
     # the same closed mesh with every triangle's own vertices (a soup, as an STL stores it)
     assert edges_shared(v[f].reshape(-1, 3), np.arange(3 * len(f)).reshape(-1, 3))
+
+
+def test_edges_balanced_tells_oriented_meshes():
+    v, f = _cube()
+    assert edges_balanced(v, f) and edges_balanced(*_two_shells())
+    assert not edges_balanced(v, _turned(f))               # closed, not oriented
+    assert edges_shared(v, _turned(f))
+    assert not MeshClassifier(v, _turned(f)).oriented and MeshClassifier(v, f).oriented
 
 
 def test_open_mesh_is_never_cut_by_a_plane_alone():

@@ -148,3 +148,29 @@ def test_float_filter_alone_would_be_wrong():
             break
     assert bad is not None, "no float failure found: the test would prove nothing"
     assert int(det2_sign(a, b, bad, q)[0]) == det2_exact(a[0], b[0], bad[0], q[0])
+
+
+def test_expansion_signs_are_the_exact_integers():
+    """det2_exact and orient3d_exact (Shewchuk's expansions, compiled) give the sign of
+    the exact determinant wherever they give one, on lattice ties and on random input,
+    and decline (UNSURE) where a difference is not exact or a factor is out of range."""
+    from implicitvox.triangles.expansions import UNSURE, det2_exact, orient3d_exact
+    rng = np.random.default_rng(21)
+    n = 3000
+    grid = rng.integers(-2, 3, (n, 12)) / 4.0                 # ties: many zeros
+    loose = rng.uniform(-1, 1, (n, 12)) * 2.0 ** rng.integers(-40, 40, (n, 1))
+    near = grid + rng.integers(-1, 2, (n, 12)) * 2.0 ** -52    # off a tie by an ulp
+    for cols in (grid, loose, near):
+        c = [cols[:, i] for i in range(12)]
+        want2 = det2_sign((c[0], c[1]), (c[2], c[3]), (c[4], c[5]), (c[6], c[7]))
+        got2 = np.array([det2_exact(*row[:8]) for row in cols])
+        want3 = orient3d_sign(cols[:, 0:3], cols[:, 3:6], cols[:, 6:9], cols[:, 9:12])
+        got3 = np.array([orient3d_exact(*row) for row in cols])
+        for got, want in ((got2, want2), (got3, want3)):
+            given = got != UNSURE
+            assert np.array_equal(got[given], want[given])
+            if cols is grid:
+                assert given.all() and (want == 0).mean() > 0.05
+    assert det2_exact(0.0, 0.0, 0.1, 0.0, 0.0, 0.0, 0.0, 0.3) == 1
+    assert det2_exact(0.0, 0.0, 1.0, 1.0, 0.0, 0.0, 2.0 ** -250, 2.0 ** -250) == UNSURE
+    assert det2_exact(1e-20, 0.0, 1.0, 1.0, 0.0, 0.0, 0.7, 0.2) == UNSURE   # 1 - 1e-20 rounds
