@@ -6,8 +6,9 @@ rotate_extrude, color, render, import`` (triangle meshes: STL, PLY, OBJ, VTK;
 DXF drawings as OpenSCAD reads them),
 ``hull``, ``minkowski`` and ``resize`` (exact on polytopes,
 :mod:`csg.polytopes`: the operands must be booleans of boxes, polyhedra,
-polygons, faceted primitives and straight extrusions, a 2D Minkowski
-operand a union of convex pieces; with
+polygons, faceted primitives and straight extrusions; a 2D Minkowski sum
+with a piece that is not convex is OpenSCAD's own, by Clipper,
+:func:`csg.clipper2d.minkowski`; with
 ``facets="true"`` their curved children are taken as OpenSCAD's facets, with
 a warning, since the hull of curved solids is no polytope and OpenSCAD itself
 builds it on its facets; ``resize`` scales by the bounding box of those
