@@ -173,32 +173,37 @@ def _edge_axes(v, normal_sign, t, lo, hi, k):
     x2, y2, z2 = v[t, 2, 0], v[t, 2, 1], v[t, 2, 2]
     lx, ly, lz = lo[k, 0], lo[k, 1], lo[k, 2]
     hx, hy, hz = hi[k, 0], hi[k, 1], hi[k, 2]
-    unsure = False
-    # box axis x: the plane (y, z)
-    n = normal_sign[t, 0]
-    for r in (_edge_axis(y0, z0, y1, z1, y2, z2, n, ly, lz, hy, hz),
-              _edge_axis(y1, z1, y2, z2, y0, z0, n, ly, lz, hy, hz),
-              _edge_axis(y2, z2, y0, z0, y1, z1, n, ly, lz, hy, hz)):
-        if r == 0:
-            return 0
-        unsure = unsure or r == UNSURE
-    # box axis y: the plane (z, x)
-    n = normal_sign[t, 1]
-    for r in (_edge_axis(z0, x0, z1, x1, z2, x2, n, lz, lx, hz, hx),
-              _edge_axis(z1, x1, z2, x2, z0, x0, n, lz, lx, hz, hx),
-              _edge_axis(z2, x2, z0, x0, z1, x1, n, lz, lx, hz, hx)):
-        if r == 0:
-            return 0
-        unsure = unsure or r == UNSURE
-    # box axis z: the plane (x, y)
-    n = normal_sign[t, 2]
-    for r in (_edge_axis(x0, y0, x1, y1, x2, y2, n, lx, ly, hx, hy),
-              _edge_axis(x1, y1, x2, y2, x0, y0, n, lx, ly, hx, hy),
-              _edge_axis(x2, y2, x0, y0, x1, y1, n, lx, ly, hx, hy)):
-        if r == 0:
-            return 0
-        unsure = unsure or r == UNSURE
-    return UNSURE if unsure else 1
+    # box axis x: the plane (y, z); y: (z, x); z: (x, y)
+    rx = _plane_edges(y0, z0, y1, z1, y2, z2, normal_sign[t, 0], ly, lz, hy, hz)
+    if rx == 0:
+        return 0
+    ry = _plane_edges(z0, x0, z1, x1, z2, x2, normal_sign[t, 1], lz, lx, hz, hx)
+    if ry == 0:
+        return 0
+    rz = _plane_edges(x0, y0, x1, y1, x2, y2, normal_sign[t, 2], lx, ly, hx, hy)
+    if rz == 0:
+        return 0
+    return UNSURE if UNSURE in (rx, ry, rz) else 1
+
+
+@njit(inline="always", **COMPILE)
+def _plane_edges(a0, a1, b0, b1, c0, c1, n, lo0, lo1, hi0, hi1):
+    """The three edge axes of one box axis: the triangle ``a, b, c`` and the box
+    projected on the plane normal to it (coordinates ``0, 1``), the triangle's
+    normal component along the axis of sign ``n``: 0 where an edge separates, 1
+    where none does, UNSURE where none surely does and a filter failed."""
+    r = _edge_axis(a0, a1, b0, b1, c0, c1, n, lo0, lo1, hi0, hi1)
+    if r == 0:
+        return 0
+    unsure = r == UNSURE
+    r = _edge_axis(b0, b1, c0, c1, a0, a1, n, lo0, lo1, hi0, hi1)
+    if r == 0:
+        return 0
+    unsure = unsure or r == UNSURE
+    r = _edge_axis(c0, c1, a0, a1, b0, b1, n, lo0, lo1, hi0, hi1)
+    if r == 0:
+        return 0
+    return UNSURE if unsure or r == UNSURE else 1
 
 
 @njit(inline="always", **COMPILE)
