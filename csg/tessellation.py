@@ -14,7 +14,8 @@ repeats libtess2's steps for one quad, in single precision as libtess2 computes
 2. libtess2's normal (``ComputeNormal``: the corners farthest apart along the
    axis of largest extent, and the corner making the largest triangle with
    them, the first found on ties in the order of libtess2's vertex list: the
-   contour from its second corner on, its first corner last), and the projection that drops the normal's longest axis
+   contour from its second corner on, its first corner last), and the projection
+   that drops the normal's longest axis
    (``tessProjectPolygon``: ``s`` the next axis, ``t`` the one after, signed by
    the normal, then flipped so that the contour's area is positive:
    ``CheckOrientation``);

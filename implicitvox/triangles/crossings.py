@@ -16,7 +16,8 @@ where it enters. Each test is a sign of exact predicates
 Only the triangles whose shadow's box holds ``(p_y, p_z)`` are tested (a
 uniform grid on the ``yz`` plane), so a query costs a few tests, not one per
 triangle; the tests run compiled (:mod:`implicitvox.triangles.crossing_kernels`,
-floating-point filters), the pairs they cannot certify on the exact array path. For open meshes use the generalized winding number
+floating-point filters), the pairs they cannot certify on the exact array path.
+For open meshes use the generalized winding number
 (:mod:`implicitvox.triangles.winding`) instead.
 
 Examples
@@ -99,12 +100,9 @@ class RayWinding:
         near = np.all((t.lo[tri][:, 1:] <= q[:, 1:]) & (t.hi[tri][:, 1:] >= q[:, 1:]), axis=1)
         pts, tri, q = pts[near], tri[near], q[near]
         from .crossing_kernels import crossing_pairs     # (loads Numba: not at import)
-        from .tribox_kernels import UNSURE
-        crossing = crossing_pairs(t, tri, q).astype(np.int64)
-        unsure = np.flatnonzero(crossing == UNSURE)
-        if len(unsure):
-            crossing[unsure] = self.crossings_by_arrays(tri[unsure], q[unsure])
-        np.add.at(out, pts, crossing)
+        from .tribox_kernels import settled
+        crossing = settled(crossing_pairs(t, tri, q), self.crossings_by_arrays, tri, q)
+        np.add.at(out, pts, crossing.astype(np.int64))
         return out
 
     def crossings_by_arrays(self, tri: np.ndarray, q: np.ndarray) -> np.ndarray:

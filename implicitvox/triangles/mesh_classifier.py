@@ -57,16 +57,21 @@ def edges_shared(vertices: np.ndarray, faces: np.ndarray) -> bool:
     """Whether every edge of the mesh (between two distinct points, vertices merged
     by their coordinates) lies on two face slots at least: no boundary edge, so
     each point of a triangle's edge lies on another triangle too."""
+    a, b, n = _edges(vertices, faces)
+    _, count = np.unique(np.minimum(a, b) * n + np.maximum(a, b), return_counts=True)
+    return bool(np.all(count >= 2))
+
+
+def _edges(vertices: np.ndarray, faces: np.ndarray) -> tuple[np.ndarray, np.ndarray, int]:
+    """The faces' edges ``a -> b`` between two distinct points (vertices merged by their
+    coordinates, int64 numbers), and the number of points."""
     v = np.asarray(vertices, dtype=np.float64)[np.asarray(faces)].reshape(-1, 3) + 0.0
     _, point = np.unique(v, axis=0, return_inverse=True)
-    point = point.reshape(-1, 3)
+    point = point.reshape(-1, 3).astype(np.int64)
     a = point.ravel()
     b = np.roll(point, -1, axis=1).ravel()
     real = a != b
-    lo, hi = np.minimum(a, b)[real], np.maximum(a, b)[real]
-    _, count = np.unique(lo.astype(np.int64) * (int(point.max(initial=0)) + 1) + hi,
-                         return_counts=True)
-    return bool(np.all(count >= 2))
+    return a[real], b[real], int(point.max(initial=0)) + 1
 
 
 def edges_balanced(vertices: np.ndarray, faces: np.ndarray) -> bool:
@@ -74,14 +79,7 @@ def edges_balanced(vertices: np.ndarray, faces: np.ndarray) -> bool:
     one end to the other as back by the faces: the oriented surface has no boundary,
     so the count of the triangles a ray crosses, signed, is the same for every ray
     from a point (its winding number)."""
-    v = np.asarray(vertices, dtype=np.float64)[np.asarray(faces)].reshape(-1, 3) + 0.0
-    _, point = np.unique(v, axis=0, return_inverse=True)
-    point = point.reshape(-1, 3).astype(np.int64)
-    a = point.ravel()
-    b = np.roll(point, -1, axis=1).ravel()
-    real = a != b
-    a, b = a[real], b[real]
-    n = int(point.max(initial=0)) + 1
+    a, b, n = _edges(vertices, faces)
     key = np.minimum(a, b) * n + np.maximum(a, b)
     keys, index = np.unique(key, return_inverse=True)
     balance = np.zeros(len(keys), dtype=np.int64)

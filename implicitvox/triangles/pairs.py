@@ -47,7 +47,6 @@ __all__ = ["surface_codes", "start_pairs", "run_pairs", "split_pairs", "PairsJob
 CHUNK = batches.TRIANGLE_PAIRS
 
 
-
 def _boxes(grid: Grid, level: int, nodes: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Float corners ``(m, 3)`` of nodes at ``level``, cropped to the grid."""
     scale = 1 << (grid.depth - level)
@@ -67,12 +66,9 @@ def _children(tris: Triangles, grid: Grid, level: int, nodes: np.ndarray,
     (compiled: :func:`implicitvox.triangles.pair_kernels.child_pairs`; the pairs
     its filters leave unsure on the exact path)."""
     from .pair_kernels import child_pairs     # (loads Numba: not at import)
-    from .tribox_kernels import UNSURE
+    from .tribox_kernels import settled
     child, tri, lo, hi, state = child_pairs(tris, grid, level, nodes, tri)
-    keep = state == 1
-    unsure = np.flatnonzero(state == UNSURE)
-    if len(unsure):
-        keep[unsure] = tris.meet_by_arrays(tri[unsure], lo[unsure], hi[unsure])
+    keep = settled(state, tris.meet_by_arrays, tri, lo, hi) == 1
     return child[keep], tri[keep]
 
 

@@ -116,13 +116,8 @@ class Triangles:
         -------
         ndarray of bool, (m,)
         """
-        from .tribox_kernels import UNSURE, meet_pairs     # (loads Numba: not at import)
-        answer = meet_pairs(self, tri, lo, hi)
-        out = answer == 1
-        unsure = np.flatnonzero(answer == UNSURE)
-        if len(unsure):
-            out[unsure] = self.meet_by_arrays(tri[unsure], lo[unsure], hi[unsure])
-        return out
+        from .tribox_kernels import meet_pairs, settled     # (loads Numba: not at import)
+        return settled(meet_pairs(self, tri, lo, hi), self.meet_by_arrays, tri, lo, hi) == 1
 
     def meet_any(self, tri: np.ndarray, lo: np.ndarray, hi: np.ndarray,
                  start: np.ndarray) -> np.ndarray:
@@ -181,12 +176,9 @@ class Triangles:
         compiled (:func:`implicitvox.triangles.tribox_kernels.plane_side_pairs`),
         the pairs its filter leaves unsure on :meth:`plane_sides_by_arrays`.
         """
-        from .tribox_kernels import UNSURE, plane_side_pairs     # (loads Numba: not at import)
-        side = plane_side_pairs(self, tri, lo, hi)
-        unsure = np.flatnonzero(side == UNSURE)
-        if len(unsure):
-            side[unsure] = self.plane_sides_by_arrays(tri[unsure], lo[unsure], hi[unsure])
-        return side
+        from .tribox_kernels import plane_side_pairs, settled    # (loads Numba: not at import)
+        return settled(plane_side_pairs(self, tri, lo, hi), self.plane_sides_by_arrays,
+                       tri, lo, hi)
 
     def plane_sides_by_arrays(self, tri: np.ndarray, lo: np.ndarray, hi: np.ndarray
                               ) -> np.ndarray:

@@ -43,15 +43,13 @@ from ..interval.rules import COMPILE
 from .expansions import UNSURE, det2_exact, orient3d_exact
 
 __all__ = ["UNSURE", "det2_filtered", "plane_filtered", "meet_pair", "meet_pairs",
-           "meet_any_pairs", "plane_side_pairs"]
+           "meet_any_pairs", "plane_side_pairs", "settled"]
 
 
 _EPS = 2.0 ** -53
 _DET2_BOUND = 4.0 * _EPS
 _DET3_BOUND = 8.0 * _EPS
 _TINY = 2.0 ** -900
-#: a factor at least this large (or zero) cannot make a product underflow
-_SAFE = 2.0 ** -300
 _INF = np.inf
 
 
@@ -230,12 +228,6 @@ def meet_pair(v, tlo, thi, normal_sign, axis, planes, t, lo, hi, glo, ghi, k):
 
 
 @njit(**COMPILE)
-def _meet_kernel(v, tlo, thi, normal_sign, axis, planes, tri, lo, hi, glo, ghi, out):
-    for k in range(tri.size):
-        out[k] = meet_pair(v, tlo, thi, normal_sign, axis, planes, tri[k], lo, hi, glo, ghi, k)
-
-
-@njit(**COMPILE)
 def _meet_any_kernel(v, tlo, thi, normal_sign, axis, planes, tri, lo, hi, glo, ghi, start,
                      groups, pairs):
     for g in range(start.size - 1):
@@ -282,10 +274,7 @@ def meet_pairs(triangles, tri: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> np
     -------
     ndarray of int8, (m,)
     """
-    out = np.empty(len(tri), dtype=np.int8)
-    if len(tri):
-        _meet_kernel(*_kernel_arguments(triangles, tri, lo, hi), out)
-    return out
+    return meet_any_pairs(triangles, tri, lo, hi, np.arange(len(tri) + 1))[1]
 
 
 def meet_any_pairs(triangles, tri: np.ndarray, lo: np.ndarray, hi: np.ndarray,
@@ -326,3 +315,17 @@ def plane_side_pairs(triangles, tri: np.ndarray, lo: np.ndarray, hi: np.ndarray)
                      np.ascontiguousarray(lo, dtype=np.float64),
                      np.ascontiguousarray(hi, dtype=np.float64), out)
     return out
+
+
+def settled(answers: np.ndarray, exact, *columns: np.ndarray) -> np.ndarray:
+    """``answers`` (a compiled kernel's, per pair) with each :data:`UNSURE` one replaced
+    by ``exact`` (the exact array path) of that pair's ``columns``.
+
+    >>> settled(np.array([1, UNSURE, 0], dtype=np.int8), lambda x: x > 5, np.arange(3) * 4)
+    array([1, 0, 0], dtype=int8)
+    """
+    unsure = np.flatnonzero(answers == UNSURE)
+    if len(unsure):
+        answers = answers.copy()
+        answers[unsure] = exact(*(c[unsure] for c in columns))
+    return answers

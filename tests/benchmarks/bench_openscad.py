@@ -36,7 +36,8 @@ For every ``/usr/share/openscad/examples/**/*.scad``:
    inscribed polygon). ``ratio`` is output voxels over STL voxels.
 
 Each model runs in a child process with a timeout; Numba's on-disk cache is filled
-first (:func:`_warm_up`, untimed), so no model carries the kernels' one-time compile. Writes the table
+first (:func:`_warm_up`, untimed), so no model carries the kernels' one-time compile.
+Writes the table
 ``openscad`` (the note of issue 17 quotes it). ``--constructs``: the same for
 one small model per construct (:data:`CONSTRUCTS`), the table
 ``openscad-constructs``. ``--tests``: the same for OpenSCAD's own test models
