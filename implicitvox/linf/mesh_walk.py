@@ -15,8 +15,9 @@ order, each walk little more than their own neighbourhood.
 
 The nearest triangle is never culled (each box holding it lies no farther
 than it), so the answer is the minimum of the exact distances over the
-triangles kept, each computed by :func:`triangle_linf` (the 13 separating axes
-of :func:`implicitvox.linf.polyhedron.triangle_distance`, operation for
+triangles kept, each computed from the triangle's row of projected axes
+(:mod:`implicitvox.linf.triangle_axes`: the 13 separating axes of
+:func:`implicitvox.linf.polyhedron.triangle_distance`, operation for
 operation, so the same float) or :func:`triangle_euclidean` (the closest point
 of :func:`implicitvox.linf.euclidean.triangle_distance`, Ericson's regions).
 In the max norm a box's distance never exceeds the distance of a triangle in
@@ -41,6 +42,7 @@ import numpy as np
 from numba import njit
 
 from ..interval.rules import COMPILE
+from .triangle_axes import ROW, axis_rows, box_gap, fill_row, linf_below
 
 __all__ = ["triangle_linf", "triangle_euclidean", "nearest_distances", "warm_up",
            "EUCLIDEAN_SLACK",
@@ -66,66 +68,20 @@ def _fmax(a, b):
 
 
 @njit(**COMPILE)
-def _along2(ua, ub, a, b, p, w, t):
-    """The separating axis ``u`` with components ``ua, ub`` on axes ``a, b`` (the
-    third zero): the box of half-widths ``w`` around ``p`` and the triangle ``t``
-    are this far apart along it, in units of the box (0 for a zero axis)."""
-    h = (0.0 + abs(ua) * w[a]) + abs(ub) * w[b]
-    d0 = (0.0 + ua * t[0, a]) + ub * t[0, b]
-    d1 = (0.0 + ua * t[1, a]) + ub * t[1, b]
-    d2 = (0.0 + ua * t[2, a]) + ub * t[2, b]
-    q = (0.0 + ua * p[a]) + ub * p[b]
-    lo = min(min(d0, d1), d2)
-    hi = max(max(d0, d1), d2)
-    return max(lo - q, q - hi) / h if h > 0 else 0.0
-
-
-@njit(**COMPILE)
-def _triangle_linf(p, w, t):
-    return _triangle_linf_below(p, w, t, np.inf)
-
-
-@njit(**COMPILE)
-def _triangle_linf_below(p, w, t, bound):
-    """The weighted max-norm distance from ``p`` to triangle ``t`` where it is below
-    ``bound``; else some value at least ``bound`` (the axes stop as soon as one
-    reaches it: the distance is their maximum)."""
-    best = 0.0
-    for a in range(3):                      # the box normals: the triangle's bounding box
-        lo = min(min(t[0, a], t[1, a]), t[2, a])
-        hi = max(max(t[0, a], t[1, a]), t[2, a])
-        best = _fmax(best, max(lo - p[a], p[a] - hi) / w[a])
-    e00, e01, e02 = t[1, 0] - t[0, 0], t[1, 1] - t[0, 1], t[1, 2] - t[0, 2]
-    f0, f1, f2 = t[2, 0] - t[0, 0], t[2, 1] - t[0, 1], t[2, 2] - t[0, 2]
-    n0 = e01 * f2 - e02 * f1
-    n1 = e02 * f0 - e00 * f2
-    n2 = e00 * f1 - e01 * f0
-    h = ((0.0 + abs(n0) * w[0]) + abs(n1) * w[1]) + abs(n2) * w[2]
-    d0 = ((0.0 + n0 * t[0, 0]) + n1 * t[0, 1]) + n2 * t[0, 2]
-    d1 = ((0.0 + n0 * t[1, 0]) + n1 * t[1, 1]) + n2 * t[1, 2]
-    d2 = ((0.0 + n0 * t[2, 0]) + n1 * t[2, 1]) + n2 * t[2, 2]
-    q = ((0.0 + n0 * p[0]) + n1 * p[1]) + n2 * p[2]
-    lo = min(min(d0, d1), d2)
-    hi = max(max(d0, d1), d2)
-    best = _fmax(best, max(lo - q, q - hi) / h if h > 0 else 0.0)
-    if best >= bound:
-        return best
-    for k in range(3):                      # the box axes crossed with each edge
-        k1 = (k + 1) % 3
-        g0, g1, g2 = t[k1, 0] - t[k, 0], t[k1, 1] - t[k, 1], t[k1, 2] - t[k, 2]
-        best = _fmax(best, _along2(-g2, g1, 1, 2, p, w, t))
-        best = _fmax(best, _along2(g2, -g0, 0, 2, p, w, t))
-        best = _fmax(best, _along2(-g1, g0, 0, 1, p, w, t))
-        if best >= bound:
-            return best
-    return best
+def _linf(p, w, r, bound):
+    """The weighted max-norm distance from ``p`` to the triangle of row ``r`` where it
+    is below ``bound`` (:func:`implicitvox.linf.triangle_axes.linf_below`)."""
+    box = box_gap(p[0], p[1], p[2], w[0], w[1], w[2], r)
+    return linf_below(p[0], p[1], p[2], w[0], w[1], w[2], r, box, bound)
 
 
 @njit(**COMPILE)
 def triangle_linf(px, py, pz, wx, wy, wz, t):
     """Weighted max-norm distance from ``(px, py, pz)`` to triangle ``t`` (3, 3):
     :func:`implicitvox.linf.polyhedron.triangle_distance` for one point."""
-    return _triangle_linf(np.array([px, py, pz]), np.array([wx, wy, wz]), t)
+    r = np.empty(ROW)
+    fill_row(t, r)
+    return _linf(np.array([px, py, pz]), np.array([wx, wy, wz]), r, np.inf)
 
 
 @njit(**COMPILE)
@@ -192,8 +148,9 @@ def _box_gap(lo, hi, node, p, w, euclidean):
 
 
 @njit(**COMPILE)
-def _walk(p, w, best, last, box_lo, box_hi, first, sizes, tri, order, leaf, euclidean, slack,
-          stack_level, stack_node, stack_gap):
+def _walk(p, w, best, last, box_lo, box_hi, first, sizes, tri, axes, order, leaf, euclidean,
+          slack,
+ stack_level, stack_node, stack_gap):
     """The culled walk for one point from the upper bound ``best`` (the distance to
     triangle ``last``, or inf and -1): ``(distance, nearest triangle, exact
     distances computed)``."""
@@ -209,7 +166,7 @@ def _walk(p, w, best, last, box_lo, box_hi, first, sizes, tri, order, leaf, eucl
         if level == depth - 1:                          # a leaf: its triangles
             for j in range(leaf * node, min(leaf * (node + 1), order.size)):
                 k = order[j]
-                d = _triangle_euclidean(p, tri[k]) if euclidean else _triangle_linf(p, w, tri[k])
+                d = _triangle_euclidean(p, tri[k]) if euclidean else _linf(p, w, axes[k], best)
                 exact += 1
                 if d < best:
                     best, last = d, k
@@ -272,10 +229,11 @@ def _candidates(glo, ghi, w, reach, box_lo, box_hi, first, sizes, order, leaf, e
 
 
 @njit(**COMPILE)
-def nearest_distances(points, weights, box_lo, box_hi, first, sizes, tri, order, leaf,
+def nearest_distances(points, weights, box_lo, box_hi, first, sizes, tri, axes, order, leaf,
                       euclidean, out):
     """The distance from each of ``points`` (n, 3) to the nearest of the triangles
-    ``tri`` (m, 3, 3) into ``out`` (n): weighted max norm (``weights`` (n, 3)), or
+    ``tri`` (m, 3, 3) into ``out`` (n): weighted max norm (``weights`` (n, 3); the
+    triangles' ``axes``, :func:`implicitvox.linf.triangle_axes.axis_rows`), or
     Euclidean. The hierarchy: level ``d``'s boxes are rows ``first[d]`` to
     ``first[d] + sizes[d]`` of ``box_lo, box_hi`` (the root level first), node
     ``i``'s children are ``2i, 2i + 1`` of the next level, and leaf ``i`` holds
@@ -308,10 +266,10 @@ def nearest_distances(points, weights, box_lo, box_hi, first, sizes, tri, order,
         best = np.inf
         if seed >= 0:          # the last group's nearest triangle: an upper bound to start from
             best = _triangle_euclidean(points[g], tri[seed]) if euclidean else \
-                _triangle_linf(points[g], weights[g], tri[seed])
+                _linf(points[g], weights[g], axes[seed], np.inf)
             exact += 1
         best, seed, done = _walk(points[g], weights[g], best, seed, box_lo, box_hi, first,
-                                 sizes, tri, order, leaf, euclidean, slack, stack_level,
+                                 sizes, tri, axes, order, leaf, euclidean, slack, stack_level,
                                  stack_node, stack_gap)
         exact += done
         out[g] = best
@@ -323,7 +281,7 @@ def nearest_distances(points, weights, box_lo, box_hi, first, sizes, tri, order,
         for i in range(g + 1, e):
             p, w = points[i], weights[i]
             d = _triangle_euclidean(p, tri[seed]) if euclidean else \
-                _triangle_linf(p, w, tri[seed])
+                _linf(p, w, axes[seed], np.inf)
             out[i] = d                                   # an upper bound, to be lowered
             reach = max(reach, d)
             for a in range(3):
@@ -336,7 +294,7 @@ def nearest_distances(points, weights, box_lo, box_hi, first, sizes, tri, order,
         if count < 0:                                    # spread out: point by point
             for i in range(g + 1, e):
                 best, _, done = _walk(points[i], weights[i], out[i], seed, box_lo, box_hi,
-                                      first, sizes, tri, order, leaf, euclidean, slack,
+                                      first, sizes, tri, axes, order, leaf, euclidean, slack,
                                       stack_level, stack_node, stack_gap)
                 out[i] = best
                 exact += done
@@ -380,7 +338,7 @@ def nearest_distances(points, weights, box_lo, box_hi, first, sizes, tri, order,
                 if euclidean:
                     d = _triangle_euclidean(p, tri[k])
                 else:
-                    d = _triangle_linf_below(p, w, tri[k], best)
+                    d = _linf(p, w, axes[k], best)
                 exact += 1
                 if d < best:
                     best = d
@@ -397,4 +355,5 @@ def warm_up() -> None:
     for euclidean in (False, True):
         nearest_distances(points, np.ones((3, 3)), tri[:, 0].copy(), tri[:, 1].copy(),
                           np.zeros(1, dtype=np.int64), np.ones(1, dtype=np.int64), tri,
-                          np.arange(2, dtype=np.int64), 2, euclidean, np.empty(3))
+                          axis_rows(tri), np.arange(2, dtype=np.int64), 2, euclidean,
+                          np.empty(3))

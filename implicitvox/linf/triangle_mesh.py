@@ -24,6 +24,7 @@ Examples
 """
 from __future__ import annotations
 
+import functools
 from typing import Any
 
 import numpy as np
@@ -115,8 +116,16 @@ class TriangleMesh(Primitive):
         out = np.empty(len(p))
         nearest_distances(np.ascontiguousarray(p, dtype=np.float64),
                           np.ascontiguousarray(w, dtype=np.float64), self.box_lo, self.box_hi,
-                          self.first, self.sizes, self.tri, self.order, _LEAF, euclidean, out)
+                          self.first, self.sizes, self.tri, self.axes, self.order, _LEAF,
+                          euclidean, out)
         return out
+
+    @functools.cached_property
+    def axes(self) -> np.ndarray:
+        """The triangles' separating axes, projected once (m, 47):
+        :func:`implicitvox.linf.triangle_axes.axis_rows` (built on first use)."""
+        from .triangle_axes import axis_rows           # (loads Numba: not at import)
+        return axis_rows(self.tri)
 
     @property
     def bounds(self):

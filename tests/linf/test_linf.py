@@ -163,6 +163,20 @@ def test_compiled_triangle_distances_are_the_array_kernels():
                                atol=1e-14)
 
 
+def test_a_triangles_projected_axes_give_its_distance_below_any_bound():
+    from implicitvox.linf.triangle_axes import axis_rows, box_gap, linf_below
+    tri, p, w = _triangles_and_points(np.random.default_rng(9), 2000)
+    rows = axis_rows(tri)
+    truth = linf.triangle_distance(p, tri, w)
+    bounds = truth * np.random.default_rng(1).uniform(0.5, 1.5, len(p))
+    for k in range(len(p)):
+        box = box_gap(*p[k], *w[k], rows[k])
+        assert box <= truth[k]
+        assert linf_below(*p[k], *w[k], rows[k], box, np.inf) == truth[k]
+        got = linf_below(*p[k], *w[k], rows[k], box, bounds[k])
+        assert got == truth[k] if truth[k] < bounds[k] else got >= bounds[k]
+
+
 def _brute_classify_sphere(c, r, lo, hi):
     """A box against a sphere's surface, Euclidean: the nearest and farthest box points."""
     near = np.linalg.norm(np.maximum(np.maximum(lo - c, c - hi), 0), axis=1)
