@@ -23,10 +23,13 @@ from ..linf.triangle_mesh import TriangleMesh
 from ..octree.grid import Grid
 from ..octree.run import Run
 from ..parallel import Job, farm
+from .bricks import masked_coords
 from .certified import certified_distances
 from .distance_kernels import Kernel, choose_kernel
+from .mesh_band import mesh_band
 
-__all__ = ["DistanceKernel", "SamplesJob", "band_distances", "CHUNK", "COST"]
+__all__ = ["DistanceKernel", "SamplesJob", "band_distances", "mesh_band_distances", "CHUNK",
+           "COST"]
 
 #: samples computed per call, by the kernel's cost (:attr:`DistanceKernel.cost`):
 #: bounded temporaries, progress steps, one farmed piece (a certified search takes
@@ -111,3 +114,18 @@ def band_distances(spec: DistanceKernel, grid: Grid, weights: np.ndarray, coords
         values[part], errors[part] = spec.kernel(grid.centers(coords[part]), weights)
         run.report(min(1.0, (s + chunk) / max(len(coords), 1)))
     return values, errors, 1
+
+
+def mesh_band_distances(mesh: TriangleMesh, grid: Grid, weights: np.ndarray, keys: np.ndarray,
+                        active: np.ndarray, band: int, run: Run) -> tuple[np.ndarray, int]:
+    """A mesh's max-norm values at the band's samples (``brick_coords(keys)[active]``),
+    signed where it is closed, by its triangles scattered over the bricks
+    (:func:`implicitvox.fields.mesh_band.mesh_band`, threads over ranges of
+    bricks), and the workers used."""
+    count = int(active.sum())
+    n = run.workers_for(count * COST["mesh"])
+    values = mesh_band(mesh, grid, keys, active, band, weights, workers=n,
+                       executor=run.executor, progress=run.progress)
+    if mesh.closed:
+        values = mesh.with_sign(grid.centers(masked_coords(keys, active)), values)
+    return values, n

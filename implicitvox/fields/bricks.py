@@ -9,10 +9,11 @@ most ``(b + 1/2)`` voxels, in either norm, is in the band.
 
 The band is stored as the bricks that hold a band voxel: sorted Morton
 codes of the bricks' indices, and per brick a ``(8, 8, 8)`` block of
-samples. Finding the band is array work: each surface voxel is paired with
-the bricks whose apron (the brick grown by ``b``) holds it, marked in a
-stack of apron blocks, and the marks are dilated by a cube of ``2b + 1``
-(three 1D maximum filters on the whole stack in one call each).
+samples. Finding the band is compiled (:func:`implicitvox.fields.brick_kernels.band_samples`):
+the bricks near a brick holding surface voxels are the candidates; each
+marks the surface voxels in its apron (the brick grown by ``b``) and dilates
+them by ``2b + 1`` along each axis in turn; those left with a sample are the
+band's.
 
 Examples
 --------
@@ -23,33 +24,18 @@ Examples
 """
 from __future__ import annotations
 
-import itertools
-
 import numpy as np
 
 from ..octree import morton
 
-__all__ = ["BRICK", "band_bricks", "all_bricks", "brick_coords", "BrickIndex", "MAX_BAND"]
+__all__ = ["BRICK", "band_bricks", "all_bricks", "brick_coords", "masked_coords", "in_grid",
+           "BrickIndex", "MAX_BAND"]
 
 #: samples per brick edge
 BRICK = 8
 _BITS = 3
 #: the widest band, in voxels
 MAX_BAND = 64
-
-
-def _pairs(surface: np.ndarray, band: int) -> tuple[np.ndarray, np.ndarray]:
-    """(surface voxel row, brick index (n, 3)) for every brick whose apron holds the voxel."""
-    first = (surface - band) >> _BITS
-    last = (surface + band) >> _BITS
-    span = int((last - first).max()) + 1 if len(surface) else 1
-    rows, bricks = [], []
-    for offset in itertools.product(range(span), repeat=3):
-        b = first + np.asarray(offset)
-        ok = np.all(b <= last, axis=1)
-        rows.append(np.flatnonzero(ok))
-        bricks.append(b[ok])
-    return np.concatenate(rows), np.concatenate(bricks)
 
 
 def band_bricks(surface: np.ndarray, band: int, shape: tuple[int, int, int]
@@ -62,29 +48,30 @@ def band_bricks(surface: np.ndarray, band: int, shape: tuple[int, int, int]
         Morton codes of the brick indices, sorted.
     active : ndarray of bool, shape (k, 8, 8, 8)
         The band's samples in each brick (inside the grid, within ``band`` of a
-        surface voxel per axis).
+        surface voxel per axis); every brick holds one.
     """
-    from scipy.ndimage import maximum_filter1d
+    from .brick_kernels import band_samples        # (loads Numba: not at import)
     surface = np.asarray(surface, dtype=np.int64).reshape(-1, 3)
     if not len(surface):
         return np.zeros(0, dtype=np.uint64), np.zeros((0, BRICK, BRICK, BRICK), dtype=bool)
-    rows, bricks = _pairs(surface, band)
-    n_bricks = -(-np.asarray(shape) // BRICK)
-    ok = np.all((bricks >= 0) & (bricks < n_bricks), axis=1)
-    rows, bricks = rows[ok], bricks[ok]
-    codes = morton.encode(bricks)
-    keys, which = np.unique(codes, return_inverse=True)
-    side = BRICK + 2 * band
-    marks = np.zeros((len(keys), side, side, side), dtype=np.uint8)
-    local = surface[rows] - bricks * BRICK + band
-    marks[which, local[:, 0], local[:, 1], local[:, 2]] = 1
-    for axis in (1, 2, 3):
-        marks = maximum_filter1d(marks, 2 * band + 1, axis=axis, mode="constant")
-    inner = slice(band, band + BRICK)
-    active = marks[:, inner, inner, inner].astype(bool)
-    coords = brick_coords(keys)
-    inside = coords < np.asarray(shape)[None, None, None, None, :]
-    return keys, active & np.all(inside, axis=-1)
+    codes = morton.encode(surface >> _BITS)
+    if np.any(codes[1:] < codes[:-1]):
+        order = np.argsort(codes, kind="stable")
+        codes, surface = codes[order], surface[order]
+    bricks, first = np.unique(codes, return_index=True)
+    start = np.append(first, len(codes)).astype(np.int64)
+    # the candidates: every brick within the band's reach of a surface brick
+    reach = -(-band // BRICK)
+    steps = np.arange(-reach, reach + 1)
+    offsets = np.stack(np.meshgrid(steps, steps, steps, indexing="ij"), -1).reshape(-1, 3)
+    near = (morton.decode(bricks)[:, None, :] + offsets[None]).reshape(-1, 3)
+    near = near[np.all((near >= 0) & (near < -(-np.asarray(shape) // BRICK)), axis=1)]
+    keys = np.unique(morton.encode(near))
+    active = np.zeros((len(keys), BRICK, BRICK, BRICK), dtype=bool)
+    band_samples(bricks, morton.decode(keys), start, surface, band,
+                 np.asarray(shape, dtype=np.int64), active)
+    held = active.any(axis=(1, 2, 3))
+    return keys[held], active[held]
 
 
 def all_bricks(shape: tuple[int, int, int]) -> tuple[np.ndarray, np.ndarray]:
@@ -93,8 +80,7 @@ def all_bricks(shape: tuple[int, int, int]) -> tuple[np.ndarray, np.ndarray]:
     counts = -(-np.asarray(shape) // BRICK)
     idx = np.stack(np.meshgrid(*[np.arange(n) for n in counts], indexing="ij"), -1).reshape(-1, 3)
     keys = np.sort(morton.encode(idx))
-    active = np.all(brick_coords(keys) < np.asarray(shape), axis=-1)
-    return keys, active
+    return keys, in_grid(keys, shape)
 
 
 def brick_coords(keys: np.ndarray) -> np.ndarray:
@@ -102,6 +88,27 @@ def brick_coords(keys: np.ndarray) -> np.ndarray:
     origins = morton.decode(np.asarray(keys, dtype=np.uint64)).astype(np.int64) * BRICK
     local = np.stack(np.meshgrid(*[np.arange(BRICK)] * 3, indexing="ij"), axis=-1)
     return origins[:, None, None, None, :] + local[None]
+
+
+def masked_coords(keys: np.ndarray, mask: np.ndarray) -> np.ndarray:
+    """Voxel indices (n, 3) of the samples ``mask`` (k, 8, 8, 8) of the bricks ``keys``,
+    brick by brick: ``brick_coords(keys)[mask]`` without the whole of it."""
+    brick, i, j, k = np.nonzero(mask)
+    origins = morton.decode(np.asarray(keys, dtype=np.uint64)).astype(np.int64) * BRICK
+    out = origins[brick]
+    out[:, 0] += i
+    out[:, 1] += j
+    out[:, 2] += k
+    return out
+
+
+def in_grid(keys: np.ndarray, shape: tuple[int, int, int]) -> np.ndarray:
+    """Which samples of the bricks ``keys`` lie in a grid of ``shape``: (k, 8, 8, 8)."""
+    origins = morton.decode(np.asarray(keys, dtype=np.uint64)).astype(np.int64) * BRICK
+    step = np.arange(BRICK)
+    inside = [origins[:, a, None] + step[None] < shape[a] for a in range(3)]
+    return inside[0][:, :, None, None] & inside[1][:, None, :, None] & \
+        inside[2][:, None, None, :]
 
 
 class BrickIndex:

@@ -32,7 +32,7 @@ from .. import validate
 from ..octree.budget import size_text
 from ..octree.grid import Grid
 from ..octree.voxels import DEFAULT_DENSE_LIMIT, Voxels
-from .bricks import BRICK, BrickIndex, brick_coords
+from .bricks import BRICK, BrickIndex, brick_coords, masked_coords
 
 __all__ = ["DistanceField", "OUTPUTS", "NORMS"]
 
@@ -110,7 +110,7 @@ class DistanceField:
 
     def coords(self) -> np.ndarray:
         """Voxel indices (n, 3) of the band's samples, brick by brick."""
-        return brick_coords(self.keys)[self.active]
+        return masked_coords(self.keys, self.active)
 
     def band_values(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """``(coords (n, 3), values (n,), errors (n,))`` of the band's samples."""
@@ -140,11 +140,14 @@ class DistanceField:
             return inside
         from ..octree import morton
         depth = self.grid.depth
+        finest = morton.encode(np.asarray(coords, dtype=np.int64))
         for level, octants in self.voxels.interior.items():
+            if not len(octants):
+                continue
             codes = np.sort(morton.encode(np.asarray(octants, dtype=np.int64)))
-            mine = morton.encode(coords >> (depth - level))
-            at = np.minimum(np.searchsorted(codes, mine), max(len(codes) - 1, 0))
-            inside |= (len(codes) > 0) & (codes[at] == mine)
+            mine = finest >> np.uint64(3 * (depth - level))   # the octant's code at ``level``
+            at = np.minimum(np.searchsorted(codes, mine), len(codes) - 1)
+            inside |= codes[at] == mine
         return inside
 
     def _lattice(self, points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -32,8 +32,8 @@ from ..octree.run import Run
 from ..triangles.inputs import as_triangles
 from ..voxelizers.implicit import voxelize
 from ..voxelizers.mesh import voxelize_mesh
-from .bricks import BRICK, MAX_BAND, all_bricks, band_bricks, brick_coords
-from .band_chunks import DistanceKernel, band_distances
+from .bricks import BRICK, MAX_BAND, all_bricks, band_bricks, in_grid, masked_coords
+from .band_chunks import DistanceKernel, band_distances, mesh_band_distances
 from .field import NORMS, DistanceField
 from .suitability import CRITICAL_RADIUS, SUITABILITY_CHECK_LIMIT, is_suitable_at, solid_voxels
 
@@ -172,9 +172,14 @@ def distance_field(shape: Any, resolution: Union[int, tuple[int, int, int], None
     if spec.kernel.kind == "certified":
         spec.boxes = _surface_boxes(vox)
     kernel = spec.kernel
-    coords = brick_coords(keys)[active]
-    values_band, errors_band, used = band_distances(spec, grid, weights, coords,
-                                                    run.part(0.2, 1.0))
+    if mesh is not None and norm == "linf" and band is not None:
+        values_band, used = mesh_band_distances(mesh, grid, weights, keys, active, band,
+                                                run.part(0.2, 1.0))
+        errors_band = np.zeros(len(values_band))
+    else:
+        values_band, errors_band, used = band_distances(spec, grid, weights,
+                                                        masked_coords(keys, active),
+                                                        run.part(0.2, 1.0))
     field = _assemble(grid, norm, band, keys, active, values_band, errors_band, kernel.kind, vox)
     field.signed = mesh is None or mesh.closed
     field.metadata["suitable"] = _check_suitability(target, vox) if check_suitability and \
@@ -217,16 +222,20 @@ def _surface_boxes(vox) -> tuple[np.ndarray, np.ndarray]:
 
 def _assemble(grid, norm, band, keys, active, values_band, errors_band, kind, vox
               ) -> DistanceField:
-    """The bricks: band samples from the kernel, the rest the signed background."""
-    field = DistanceField(grid, norm, band, keys, np.zeros(active.shape), np.zeros(active.shape),
+    """The bricks: band samples from the kernel, the rest the signed background (NaN
+    beyond the grid)."""
+    field = DistanceField(grid, norm, band, keys, np.empty(active.shape), np.zeros(active.shape),
                           active, kind, voxels=vox)
-    background = field.background
-    field.values[active] = values_band
+    values = field.values
+    values[active] = values_band
     field.errors[active] = errors_band
-    rest = ~active
-    if rest.any():
-        coords = brick_coords(keys)[rest]
-        inside_grid = np.all(coords < np.asarray(grid.shape), axis=1)
-        signs = np.where(field.in_solid(coords), -1.0, 1.0)
-        field.values[rest] = np.where(inside_grid, signs * background, np.nan)
+    inside = in_grid(keys, grid.shape)
+    values[~inside] = np.nan
+    rest = inside & ~active
+    values[rest] = field.background
+    if vox is not None and len(vox.interior):
+        solid = field.in_solid(masked_coords(keys, rest))
+        held = values[rest]
+        held[solid] = -field.background
+        values[rest] = held
     return field

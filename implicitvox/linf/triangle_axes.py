@@ -34,7 +34,7 @@ from numba import njit
 
 from ..interval.rules import COMPILE
 
-__all__ = ["ROW", "EDGE_AXES", "axis_rows", "fill_row", "box_gap", "linf_below"]
+__all__ = ["ROW", "EDGE_AXES", "axis_rows", "fill_row", "box_side", "box_gap", "linf_below"]
 
 #: numbers per triangle in :func:`axis_rows`' table
 ROW = 47
@@ -100,12 +100,18 @@ def axis_rows(tri):
 
 
 @njit(**COMPILE)
+def box_side(r, a, p, w):
+    """The gap along box normal ``a`` (of weight ``w``) from coordinate ``p``: a
+    term of :func:`box_gap`, at least it when 0 is given first."""
+    return _fmax(0.0, max(r[a] - p, p - r[3 + a]) / w)
+
+
+@njit(**COMPILE)
 def box_gap(p0, p1, p2, w0, w1, w2, r):
     """The gap along the box normals alone (the triangle's bounding box): a lower bound
-    of the distance, and the first term of :func:`linf_below`."""
-    best = _fmax(0.0, max(r[0] - p0, p0 - r[3]) / w0)
-    best = _fmax(best, max(r[1] - p1, p1 - r[4]) / w1)
-    return _fmax(best, max(r[2] - p2, p2 - r[5]) / w2)
+    of the distance, and the first term of :func:`linf_below`; the larger of the
+    three :func:`box_side` terms (the same float, in any grouping)."""
+    return _fmax(_fmax(box_side(r, 0, p0, w0), box_side(r, 1, p1, w1)), box_side(r, 2, p2, w2))
 
 
 @njit(**COMPILE)

@@ -91,7 +91,7 @@ class TriangleMesh(Primitive):
         """Weighted max-norm distance (negative inside a closed mesh)."""
         p = as_points(points)
         w = as_weights(weights, len(p))
-        return self._signed(p, in_blocks(self._unsigned, p, w, _BLOCK))
+        return self.with_sign(p, in_blocks(self._unsigned, p, w, _BLOCK))
 
     def euclidean_distance(self, points: Any) -> np.ndarray:
         """Euclidean distance (negative inside a closed mesh): the same hierarchy walk,
@@ -99,9 +99,12 @@ class TriangleMesh(Primitive):
         p = as_points(points)
         unsigned = in_blocks(lambda q, w: self._unsigned(q, w, euclidean=True), p,
                              np.ones((len(p), 3)), _BLOCK)
-        return self._signed(p, unsigned)
+        return self.with_sign(p, unsigned)
 
-    def _signed(self, p: np.ndarray, unsigned: np.ndarray) -> np.ndarray:
+    def with_sign(self, points: np.ndarray, unsigned: np.ndarray) -> np.ndarray:
+        """``unsigned`` distances at ``points`` (n, 3), negative inside a closed mesh
+        (its exact winding number is nonzero there); as they are for an open one."""
+        p = as_points(points)
         if not self.closed:
             return unsigned
         if self._winding is None:

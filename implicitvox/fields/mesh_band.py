@@ -1,0 +1,165 @@
+"""A mesh's max-norm band, triangle by triangle over the bricks (Varadhan §4.2).
+
+Varadhan §4.2 computes a max-norm distance field by rendering, slice by slice,
+each triangle's distance function over its region of influence, the depth
+test keeping the least value: at each sample, the minimum over the triangles
+that reach it. :func:`mesh_band` takes the same minimum on the CPU, exactly,
+over the band's bricks (OpenVDB's 8³ leaves).
+
+**Which triangles reach a sample.** A band sample lies within ``band`` voxels
+(per axis) of a surface voxel, and the surface meets that voxel (the
+voxelizer misses none), so the sample's distance is at most ``band + 1/2``
+longest voxel edges, and its nearest triangle's nearest point lies within
+``(band + 1/2) h_a`` of it along each axis ``a``: inside the triangle's
+bounding box grown by that much. Each triangle goes to the samples of its
+grown box, and each sample keeps the least of their exact distances
+(:func:`implicitvox.linf.triangle_axes.linf_below`, the same float as
+everywhere else). The argument leans on the voxelization; the result does
+not: a sample whose least value exceeds the reach (none, where the argument
+holds) is computed again by the hierarchy walk
+(:meth:`implicitvox.linf.TriangleMesh.distance`), so every value is the exact
+minimum over all triangles either way.
+
+**Culling** (§4.1's lower and upper bounds). A brick lists the triangles whose
+grown box meets it, nearest to its centre first: a sample's least value falls
+after its first few triangles, and then most of the rest are dropped by their
+bounding box's distance, a lower bound, before any other axis is projected.
+
+**Threads.** Bricks are independent: threads take ranges of them (the
+compiled loop releases the GIL), and the values are the same for any number.
+
+Examples
+--------
+>>> import numpy as np, pyvista as pv
+>>> from implicitvox.linf import TriangleMesh
+>>> from implicitvox.triangles.inputs import as_triangles
+>>> from implicitvox.octree.grid import Grid
+>>> mesh = TriangleMesh(*as_triangles(pv.Cube()))
+>>> grid = Grid((-1.0, -1.0, -1.0), (0.25, 0.25, 0.25), (8, 8, 8))
+>>> keys = np.zeros(1, dtype=np.uint64)
+>>> active = np.ones((1, 8, 8, 8), dtype=bool)
+>>> values = mesh_band(mesh, grid, keys, active, 4, workers=1)
+>>> bool(np.array_equal(values, np.abs(mesh.distance(grid.centers(np.argwhere(active[0]))))))
+True
+"""
+from __future__ import annotations
+
+from typing import Any, Callable, Optional
+
+import numpy as np
+
+from ..linf.triangle_mesh import TriangleMesh
+from ..octree import morton
+from ..octree.grid import Grid
+from ..parallel import Job, farm
+from .bricks import BRICK, masked_coords
+
+__all__ = ["mesh_band", "brick_triangles", "PIECE_PAIRS"]
+
+#: brick-triangle pairs per piece handed to a thread (progress steps, balance)
+PIECE_PAIRS = 1 << 16
+#: the reach's allowance for rounding, in voxels (coordinates have at most 21 bits)
+_SLACK = 1e-6
+
+
+def _kernels():
+    from . import mesh_band_kernels     # (loads Numba: not at import)
+    return mesh_band_kernels
+
+
+def brick_triangles(rows: np.ndarray, keys: np.ndarray, grid: Grid, reach: np.ndarray
+                    ) -> tuple[np.ndarray, np.ndarray]:
+    """Per brick of ``keys``, the triangles (rows of
+    :func:`~implicitvox.linf.triangle_axes.axis_rows`) whose bounding box grown by
+    ``reach`` (per axis, world units) holds a sample of the brick, nearest to the
+    brick's centre first: ``(start, triangles)``, brick ``b``'s in
+    ``triangles[start[b]:start[b + 1]]``."""
+    origins = morton.decode(keys).astype(np.int64) * BRICK
+    kernels = _kernels()
+    return kernels.brick_triangles(rows, keys, origins, np.asarray(grid.origin, dtype=float),
+                                   np.asarray(grid.voxel_size, dtype=float),
+                                   np.asarray(grid.shape, dtype=np.int64),
+                                   np.asarray(reach, dtype=float), _SLACK)
+
+
+class _BandJob(Job):
+    """The triangles, bricks and grid every range of bricks shares (threads)."""
+
+    def __init__(self, mesh: TriangleMesh, grid: Grid, keys: np.ndarray, active: np.ndarray,
+                 weights: np.ndarray, reach: np.ndarray):
+        super().__init__()
+        self.mesh, self.grid, self.active, self.weights = mesh, grid, active, weights
+        self.reach = reach
+        self.origins = morton.decode(keys).astype(np.int64) * BRICK
+        self.start, self.triangles = brick_triangles(mesh.axes, keys, grid, reach)
+        self.centres = [0.5 * (grid.edge(a, np.arange(grid.shape[a]))
+                               + grid.edge(a, np.arange(grid.shape[a]) + 1)) for a in range(3)]
+
+    def run(self, piece: tuple[int, int]) -> np.ndarray:
+        """The least values of bricks ``piece[0]`` to ``piece[1]``: (bricks, 8, 8, 8)."""
+        b0, b1 = piece
+        values = np.full((b1 - b0, BRICK, BRICK, BRICK), np.inf)
+        _kernels().scatter_bricks(b0, b1, self.start, self.triangles, self.mesh.axes,
+                                  self.origins, self.active, *self.centres, self.weights,
+                                  self.reach, values)
+        return values
+
+
+def mesh_band(mesh: TriangleMesh, grid: Grid, keys: np.ndarray, active: np.ndarray,
+              band: int, weights: Any = None, *, workers: int = 1, executor: Any = None,
+              progress: Optional[Callable[[float], Any]] = None) -> np.ndarray:
+    """Unsigned weighted max-norm distances from ``mesh`` at the band's samples.
+
+    Parameters
+    ----------
+    mesh : TriangleMesh
+    grid : Grid
+        Sample ``(i, j, k)`` is the centre of voxel ``(i, j, k)``.
+    keys, active
+        The band's bricks (:func:`implicitvox.fields.bricks.band_bricks`).
+    band : int
+        Every active sample lies within ``band`` voxels (per axis) of a voxel
+        the surface meets.
+    weights : (3,) array, optional
+        The norm's weights (voxel size over its longest edge); default 1.
+    workers : int, default: 1
+        Threads over ranges of bricks (the same values for any number).
+    executor, progress
+        As for :func:`implicitvox.parallel.farm`.
+
+    Returns
+    -------
+    ndarray (n,)
+        The distance at each active sample, in the order of
+        ``brick_coords(keys)[active]``.
+    """
+    h = np.asarray(grid.voxel_size, dtype=float)
+    w = np.ones(3) if weights is None else np.asarray(weights, dtype=float).reshape(3)
+    reach = (band + 0.5) * h * (1 + _SLACK)
+    job = _BandJob(mesh, grid, keys, active, w, reach)
+    pieces = _pieces(job.start)
+    values = np.empty(active.shape)
+    if workers > 1 or executor is not None:
+        results = farm(job, pieces, workers=workers, executor=executor, progress=progress,
+                       weights=[job.start[b1] - job.start[b0] + 1 for b0, b1 in pieces],
+                       what=f"scattering triangles over {len(keys):,} bricks", threads=True)
+    else:
+        results = ((i, job.run(piece)) for i, piece in enumerate(pieces))
+    for i, part in results:
+        b0, b1 = pieces[i]
+        values[b0:b1] = part
+        if progress is not None and workers <= 1 and executor is None:
+            progress(b1 / max(len(keys), 1))
+    far = active & (values > (band + 0.5) * float(h.max()))
+    if far.any():          # beyond every triangle's reach: the walk over all of them
+        points = grid.centers(masked_coords(keys, far))
+        values[far] = np.abs(mesh.distance(points, np.broadcast_to(w, points.shape)))
+    return values[active]
+
+
+def _pieces(start: np.ndarray) -> list[tuple[int, int]]:
+    """Ranges of bricks of about :data:`PIECE_PAIRS` brick-triangle pairs each."""
+    n = len(start) - 1
+    cuts = np.searchsorted(start, np.arange(PIECE_PAIRS, start[-1], PIECE_PAIRS))
+    bounds = np.unique(np.concatenate([[0], cuts, [n]]))
+    return [(int(a), int(b)) for a, b in zip(bounds[:-1], bounds[1:])]

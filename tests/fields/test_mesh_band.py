@@ -1,0 +1,63 @@
+"""The band's bricks and a mesh's max-norm band by scattered triangles, against oracles."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import pyvista as pv
+from scipy import ndimage
+
+from implicitvox.fields.bricks import BRICK, band_bricks, masked_coords
+from implicitvox.fields.mesh_band import mesh_band
+from implicitvox.linf import TriangleMesh
+from implicitvox.octree import morton
+from implicitvox.triangles.inputs import as_triangles
+from implicitvox.voxelizers.mesh import voxelize_mesh
+
+
+@pytest.mark.parametrize("band", [1, 3, 9])
+def test_band_bricks_are_the_dilation_of_the_surface_voxels(band):
+    rng = np.random.default_rng(band)
+    shape = (37, 29, 41)
+    surface = np.unique(rng.integers(0, shape, (60, 3)), axis=0)
+    dense = np.zeros(shape, dtype=bool)
+    dense[tuple(surface.T)] = True
+    truth = ndimage.binary_dilation(dense, np.ones((2 * band + 1,) * 3, dtype=bool))
+    keys, active = band_bricks(surface[rng.permutation(len(surface))], band, shape)
+    got = masked_coords(keys, active)
+    assert len(got) == truth.sum()
+    assert truth[tuple(got.T)].all()
+    assert np.array_equal(keys, np.unique(morton.encode(np.argwhere(truth) // BRICK)))
+
+
+def _mesh_and_band(band):
+    sphere = pv.Sphere(radius=1.0, theta_resolution=14, phi_resolution=11)
+    sphere.points = sphere.points * np.array([1.0, 0.7, 0.45]) @ np.array(
+        [[0.8, 0.6, 0.0], [-0.6, 0.8, 0.0], [0.0, 0.0, 1.0]])
+    v, f = as_triangles(sphere)
+    mesh = TriangleMesh(v, f)
+    vox = voxelize_mesh((v, f), (52, 60, 25), bounds=((-1.3, -1.2, -0.8), (1.3, 1.2, 0.825)))
+    assert len(set(vox.grid.voxel_size)) == 3                # not cubes
+    keys, active = band_bricks(vox.coords(), band, vox.grid.shape)
+    return mesh, vox.grid, keys, active
+
+
+def test_the_scattered_band_is_the_walk_bit_for_bit_on_any_number_of_threads():
+    mesh, grid, keys, active = _mesh_and_band(3)
+    h = np.asarray(grid.voxel_size)
+    w = h / h.max()
+    points = grid.centers(masked_coords(keys, active))
+    walk = np.abs(mesh.distance(points, np.broadcast_to(w, points.shape)))
+    one = mesh_band(mesh, grid, keys, active, 3, w, workers=1)
+    assert np.array_equal(one, walk)
+    assert np.array_equal(mesh_band(mesh, grid, keys, active, 3, w, workers=2), one)
+    assert one.max() <= 3.5 * h.max()
+
+
+def test_samples_beyond_every_triangles_reach_are_walked():
+    mesh, grid, keys, active = _mesh_and_band(1)
+    everywhere = np.ones_like(active)          # far more than the band of 1 voxel
+    w = np.asarray(grid.voxel_size) / max(grid.voxel_size)
+    points = grid.centers(masked_coords(keys, everywhere))
+    got = mesh_band(mesh, grid, keys, everywhere, 1, w)
+    assert got.max() > 1.5 * max(grid.voxel_size)
+    assert np.array_equal(got, np.abs(mesh.distance(points, np.broadcast_to(w, points.shape))))
