@@ -98,10 +98,9 @@ class _BandJob(Job):
     def run(self, piece: tuple[int, int]) -> np.ndarray:
         """The least values of bricks ``piece[0]`` to ``piece[1]``: (bricks, 8, 8, 8)."""
         b0, b1 = piece
-        values = np.full((b1 - b0, BRICK, BRICK, BRICK), np.inf)
+        values = np.where(self.active[b0:b1], np.inf, -np.inf)
         _kernels().scatter_bricks(b0, b1, self.start, self.triangles, self.mesh.axes,
-                                  self.origins, self.active, *self.centres, self.weights,
-                                  self.reach, values)
+                                  self.origins, *self.centres, self.weights, self.reach, values)
         return values
 
 

@@ -81,12 +81,13 @@ def brick_triangles(rows, keys, origins, origin, h, shape, reach, slack):
 
 
 @njit(**COMPILE)
-def scatter_bricks(b0, b1, start, triangles, rows, origins, active, cx, cy, cz, w, reach,
-                   values):
-    """Bricks ``b0`` to ``b1``: each listed triangle's exact distance (below the value
-    held) into ``values[b - b0]`` at the active samples within ``reach`` of its box."""
+def scatter_bricks(b0, b1, start, triangles, rows, origins, cx, cy, cz, w, reach, values):
+    """Bricks ``b0`` to ``b1``: each listed triangle's exact distance, where below the
+    value held, into ``values[b - b0]`` at the samples within ``reach`` of its box
+    (samples to skip hold -inf)."""
     slack = 1e-6
     w0, w1, w2 = w[0], w[1], w[2]
+    sides = np.empty(BRICK)
     for b in range(b0, b1):
         o0, o1, o2 = origins[b, 0], origins[b, 1], origins[b, 2]
         out = values[b - b0]
@@ -96,23 +97,23 @@ def scatter_bricks(b0, b1, start, triangles, rows, origins, active, cx, cy, cz, 
             f0, l0 = _local_range(r[0], r[3], cx, o0, reach[0], slack)
             f1, l1 = _local_range(r[1], r[4], cy, o1, reach[1], slack)
             f2, l2 = _local_range(r[2], r[5], cz, o2, reach[2], slack)
+            for i2 in range(f2, l2 + 1):
+                sides[i2] = box_side(r, 2, cz[o2 + i2], w2)
             for i0 in range(f0, l0 + 1):
                 p0 = cx[o0 + i0]
                 g0 = box_side(r, 0, p0, w0)
                 for i1 in range(f1, l1 + 1):
                     p1 = cy[o1 + i1]
                     g1 = max(g0, box_side(r, 1, p1, w1))
+                    row = out[i0, i1]
                     for i2 in range(f2, l2 + 1):
-                        if not active[b, i0, i1, i2]:
-                            continue
-                        p2 = cz[o2 + i2]
-                        best = out[i0, i1, i2]
-                        box = max(g1, box_side(r, 2, p2, w2))   # box_gap's float
+                        best = row[i2]
+                        box = max(g1, sides[i2])           # box_gap's float
                         if box >= best:
                             continue
-                        d = linf_below(p0, p1, p2, w0, w1, w2, r, box, best)
+                        d = linf_below(p0, p1, cz[o2 + i2], w0, w1, w2, r, box, best)
                         if d < best:
-                            out[i0, i1, i2] = d
+                            row[i2] = d
 
 
 @njit(**COMPILE)
