@@ -30,6 +30,7 @@ from ..linf.triangle_mesh import TriangleMesh
 from ..octree.grid import padded_bounds
 from ..octree.run import Run
 from ..triangles.inputs import as_triangles
+from ..triangles.weld import weld
 from ..voxelizers.implicit import voxelize
 from ..voxelizers.mesh import voxelize_mesh
 from .bricks import BRICK, MAX_BAND, all_bricks, band_bricks, in_grid, masked_coords
@@ -144,7 +145,7 @@ def distance_field(shape: Any, resolution: Union[int, tuple[int, int, int], None
     first = run.part(0.0, 0.2)
     if mesh is not None:
         # the triangles with their shared vertices again (the fill needs the connectivity)
-        vertices, corners = np.unique(mesh.tri.reshape(-1, 3), axis=0, return_inverse=True)
+        vertices, corners = weld(mesh.tri.reshape(-1, 3))
         vox = voxelize_mesh((vertices, corners.reshape(-1, 3)),
                             resolution, bounds=bounds, voxel_size=voxel_size,
                             interior=mesh.closed, max_memory=first.budget,

@@ -12,6 +12,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from .weld import weld
+
 __all__ = ["mesh_volume", "hull_mesh", "is_convex_mesh", "is_closed_mesh", "CONVEX_TOLERANCE"]
 
 #: a mesh is convex when its volume is its hull's within this share of the hull's
@@ -41,7 +43,7 @@ def is_closed_mesh(vertices: np.ndarray, faces: np.ndarray) -> bool:
     faces = np.asarray(faces, dtype=np.int64).reshape(-1, 3)
     if not len(faces):
         return False
-    _, same = np.unique(vertices, axis=0, return_inverse=True)
+    _, same = weld(vertices)
     f = same.reshape(-1)[faces]
     f = f[(f[:, 0] != f[:, 1]) & (f[:, 1] != f[:, 2]) & (f[:, 2] != f[:, 0])]
     if not len(f):

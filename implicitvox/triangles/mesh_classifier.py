@@ -44,6 +44,7 @@ from .crossings import RayWinding
 from .pairs import sorted_unique
 from .ranges import buckets, expand_boxes, gather, grid_cells
 from .tribox import Triangles
+from .weld import weld
 
 __all__ = ["MeshClassifier", "BoxMemory", "edges_shared", "edges_balanced", "forget_decided",
            "LISTED", "OFF"]
@@ -66,7 +67,7 @@ def _edges(vertices: np.ndarray, faces: np.ndarray) -> tuple[np.ndarray, np.ndar
     """The faces' edges ``a -> b`` between two distinct points (vertices merged by their
     coordinates, int64 numbers), and the number of points."""
     v = np.asarray(vertices, dtype=np.float64)[np.asarray(faces)].reshape(-1, 3) + 0.0
-    _, point = np.unique(v, axis=0, return_inverse=True)
+    _, point = weld(v)
     point = point.reshape(-1, 3).astype(np.int64)
     a = point.ravel()
     b = np.roll(point, -1, axis=1).ravel()

@@ -152,3 +152,14 @@ def test_boxes_the_tree_decided_are_forgotten():
     assert len(memory) == 1
     found, single, above, *_ = memory.take(2, codes)
     assert found.tolist() == [False, True, False] and single[1] == 4
+
+
+def test_weld_is_numpys_unique_along_rows():
+    from implicitvox.triangles.weld import weld
+    rng = np.random.default_rng(3)
+    p = rng.integers(-2, 3, (500, 3)).astype(float) * 0.5
+    p[5::11, 0] = -0.0                     # equal to 0.0
+    rows, inverse = weld(p)
+    truth, truth_inverse = np.unique(p, axis=0, return_inverse=True)
+    assert np.array_equal(rows, truth) and np.array_equal(inverse, truth_inverse.ravel())
+    assert np.array_equal(rows[inverse], p)
