@@ -1,21 +1,26 @@
-"""A mesh's max-norm band, triangle by triangle over the bricks (Varadhan §4.2).
+"""A mesh's distance band, triangle by triangle over the bricks (Varadhan §4.2).
 
 Varadhan §4.2 computes a max-norm distance field by rendering, slice by slice,
 each triangle's distance function over its region of influence, the depth
 test keeping the least value: at each sample, the minimum over the triangles
 that reach it. :func:`mesh_band` takes the same minimum on the CPU, exactly,
-over the band's bricks (OpenVDB's 8³ leaves).
+over the band's bricks (OpenVDB's 8³ leaves), in the max-norm or the
+Euclidean norm.
 
 **Which triangles reach a sample.** A band sample lies within ``band`` voxels
 (per axis) of a surface voxel, and the surface meets that voxel (the
-voxelizer misses none), so the sample's distance is at most ``band + 1/2``
-longest voxel edges, and its nearest triangle's nearest point lies within
-``(band + 1/2) h_a`` of it along each axis ``a``: inside the triangle's
+voxelizer misses none), so the sample lies within ``(band + 1/2) h_a`` of a
+surface point along each axis ``a``. Its max-norm distance is then at most
+``band + 1/2`` longest voxel edges, and its nearest triangle's nearest point
+lies within ``(band + 1/2) h_a`` of it along each axis; its Euclidean distance
+is at most the length ``R`` of that offset, and the nearest point lies within
+``R`` along each axis. Either way the nearest point is inside the triangle's
 bounding box grown by that much. Each triangle goes to the samples of its
 grown box, and each sample keeps the least of their exact distances
-(:func:`implicitvox.linf.triangle_axes.linf_below`, the same float as
+(:func:`implicitvox.linf.triangle_axes.linf_below` and
+:func:`implicitvox.linf.mesh_walk.triangle_euclidean`, the same floats as
 everywhere else). The argument leans on the voxelization; the result does
-not: a sample whose least value exceeds the reach (none, where the argument
+not: a sample whose least value exceeds the bound (none, where the argument
 holds) is computed again by the hierarchy walk
 (:meth:`implicitvox.linf.TriangleMesh.distance`), so every value is the exact
 minimum over all triangles either way.
@@ -38,7 +43,7 @@ Examples
 >>> grid = Grid((-1.0, -1.0, -1.0), (0.25, 0.25, 0.25), (8, 8, 8))
 >>> keys = np.zeros(1, dtype=np.uint64)
 >>> active = np.ones((1, 8, 8, 8), dtype=bool)
->>> values = mesh_band(mesh, grid, keys, active, 4, workers=1)
+>>> values = mesh_band(mesh, grid, keys, active, 4)
 >>> bool(np.array_equal(values, np.abs(mesh.distance(grid.centers(np.argwhere(active[0]))))))
 True
 """
@@ -86,10 +91,10 @@ class _BandJob(Job):
     """The triangles, bricks and grid every range of bricks shares (threads)."""
 
     def __init__(self, mesh: TriangleMesh, grid: Grid, keys: np.ndarray, active: np.ndarray,
-                 weights: np.ndarray, reach: np.ndarray):
+                 weights: np.ndarray, reach: np.ndarray, euclidean: bool):
         super().__init__()
         self.mesh, self.grid, self.active, self.weights = mesh, grid, active, weights
-        self.reach = reach
+        self.reach, self.euclidean = reach, euclidean
         self.origins = morton.decode(keys).astype(np.int64) * BRICK
         self.start, self.triangles = brick_triangles(mesh.axes, keys, grid, reach)
         self.centres = [0.5 * (grid.edge(a, np.arange(grid.shape[a]))
@@ -100,14 +105,16 @@ class _BandJob(Job):
         b0, b1 = piece
         values = np.where(self.active[b0:b1], np.inf, -np.inf)
         _kernels().scatter_bricks(b0, b1, self.start, self.triangles, self.mesh.axes,
-                                  self.origins, *self.centres, self.weights, self.reach, values)
+                                  self.mesh.tri, self.origins, *self.centres, self.weights,
+                                  self.reach, self.euclidean, values)
         return values
 
 
 def mesh_band(mesh: TriangleMesh, grid: Grid, keys: np.ndarray, active: np.ndarray,
-              band: int, weights: Any = None, *, workers: int = 1, executor: Any = None,
-              progress: Optional[Callable[[float], Any]] = None) -> np.ndarray:
-    """Unsigned weighted max-norm distances from ``mesh`` at the band's samples.
+              band: int, norm: str = "linf", weights: Any = None, *, workers: int = 1,
+              executor: Any = None, progress: Optional[Callable[[float], Any]] = None
+              ) -> np.ndarray:
+    """Unsigned distances from ``mesh`` at the band's samples.
 
     Parameters
     ----------
@@ -119,8 +126,10 @@ def mesh_band(mesh: TriangleMesh, grid: Grid, keys: np.ndarray, active: np.ndarr
     band : int
         Every active sample lies within ``band`` voxels (per axis) of a voxel
         the surface meets.
+    norm : {"linf", "euclidean"}
+        The weighted max-norm, or the Euclidean distance.
     weights : (3,) array, optional
-        The norm's weights (voxel size over its longest edge); default 1.
+        The max-norm's weights (voxel size over its longest edge); default 1.
     workers : int, default: 1
         Threads over ranges of bricks (the same values for any number).
     executor, progress
@@ -133,9 +142,15 @@ def mesh_band(mesh: TriangleMesh, grid: Grid, keys: np.ndarray, active: np.ndarr
         ``brick_coords(keys)[active]``.
     """
     h = np.asarray(grid.voxel_size, dtype=float)
-    w = np.ones(3) if weights is None else np.asarray(weights, dtype=float).reshape(3)
-    reach = (band + 0.5) * h * (1 + _SLACK)
-    job = _BandJob(mesh, grid, keys, active, w, reach)
+    euclidean = norm == "euclidean"
+    w = np.ones(3) if weights is None or euclidean else \
+        np.asarray(weights, dtype=float).reshape(3)
+    # a band sample's distance is at most its offset from a point of a surface voxel:
+    # (band + 1/2) voxels per axis; the nearest point lies that far per axis (max norm,
+    # weighted) or that offset's length along any axis (Euclidean)
+    limit = (band + 0.5) * (float(np.linalg.norm(h)) if euclidean else float(h.max()))
+    reach = (np.full(3, limit) if euclidean else (band + 0.5) * h) * (1 + _SLACK)
+    job = _BandJob(mesh, grid, keys, active, w, reach, euclidean)
     pieces = _pieces(job.start)
     values = np.empty(active.shape)
     if workers > 1 or executor is not None:
@@ -149,10 +164,11 @@ def mesh_band(mesh: TriangleMesh, grid: Grid, keys: np.ndarray, active: np.ndarr
         values[b0:b1] = part
         if progress is not None and workers <= 1 and executor is None:
             progress(b1 / max(len(keys), 1))
-    far = active & (values > (band + 0.5) * float(h.max()))
+    far = active & (values > limit)
     if far.any():          # beyond every triangle's reach: the walk over all of them
         points = grid.centers(masked_coords(keys, far))
-        values[far] = np.abs(mesh.distance(points, np.broadcast_to(w, points.shape)))
+        values[far] = np.abs(mesh.euclidean_distance(points) if euclidean else
+                             mesh.distance(points, np.broadcast_to(w, points.shape)))
     return values[active]
 
 

@@ -8,6 +8,7 @@ import numpy as np
 from numba import njit
 
 from ..interval.rules import COMPILE
+from ..linf.mesh_walk import EUCLIDEAN_SLACK, triangle_euclidean
 from ..linf.triangle_axes import box_side, linf_below
 from .brick_kernels import BRICK, brick_row
 
@@ -81,37 +82,61 @@ def brick_triangles(rows, keys, origins, origin, h, shape, reach, slack):
 
 
 @njit(**COMPILE)
-def scatter_bricks(b0, b1, start, triangles, rows, origins, cx, cy, cz, w, reach, values):
-    """Bricks ``b0`` to ``b1``: each listed triangle's exact distance, where below the
-    value held, into ``values[b - b0]`` at the samples within ``reach`` of its box
-    (samples to skip hold -inf)."""
+def _side(r, a, p, w, euclidean):
+    """The box gap's term along axis ``a``: max-norm (:func:`box_side`), or squared."""
+    if euclidean:
+        g = max(max(r[a] - p, p - r[3 + a]), 0.0)
+        return g * g
+    return box_side(r, a, p, w)
+
+
+@njit(**COMPILE)
+def scatter_bricks(b0, b1, start, triangles, rows, tri, origins, cx, cy, cz, w, reach,
+                   euclidean, values):
+    """Bricks ``b0`` to ``b1``: each listed triangle's exact distance (max-norm, or
+    Euclidean), where below the value held, into ``values[b - b0]`` at the samples
+    within ``reach`` of its box (samples to skip hold -inf). A triangle whose box
+    lies farther than the value held is skipped (the Euclidean box a relative
+    :data:`~implicitvox.linf.mesh_walk.EUCLIDEAN_SLACK` farther: its distance and
+    the triangle's round differently)."""
     slack = 1e-6
+    keep = 1.0 + EUCLIDEAN_SLACK
     w0, w1, w2 = w[0], w[1], w[2]
     sides = np.empty(BRICK)
     for b in range(b0, b1):
         o0, o1, o2 = origins[b, 0], origins[b, 1], origins[b, 2]
         out = values[b - b0]
         for j in range(start[b], start[b + 1]):
-            r = rows[triangles[j]]
+            t = triangles[j]
+            r = rows[t]
             # the brick's samples within reach of the triangle's box, per axis
             f0, l0 = _local_range(r[0], r[3], cx, o0, reach[0], slack)
             f1, l1 = _local_range(r[1], r[4], cy, o1, reach[1], slack)
             f2, l2 = _local_range(r[2], r[5], cz, o2, reach[2], slack)
             for i2 in range(f2, l2 + 1):
-                sides[i2] = box_side(r, 2, cz[o2 + i2], w2)
+                sides[i2] = _side(r, 2, cz[o2 + i2], w2, euclidean)
             for i0 in range(f0, l0 + 1):
                 p0 = cx[o0 + i0]
-                g0 = box_side(r, 0, p0, w0)
+                g0 = _side(r, 0, p0, w0, euclidean)
                 for i1 in range(f1, l1 + 1):
                     p1 = cy[o1 + i1]
-                    g1 = max(g0, box_side(r, 1, p1, w1))
+                    g1 = _side(r, 1, p1, w1, euclidean)
+                    g1 = g0 + g1 if euclidean else max(g0, g1)
                     row = out[i0, i1]
                     for i2 in range(f2, l2 + 1):
                         best = row[i2]
-                        box = max(g1, sides[i2])           # box_gap's float
-                        if box >= best:
+                        if best <= 0.0:                 # nothing nearer, or not a sample
                             continue
-                        d = linf_below(p0, p1, cz[o2 + i2], w0, w1, w2, r, box, best)
+                        if euclidean:
+                            limit = best * keep
+                            if g1 + sides[i2] > limit * limit:
+                                continue
+                            d = triangle_euclidean(p0, p1, cz[o2 + i2], tri[t])
+                        else:
+                            box = max(g1, sides[i2])    # box_gap's float
+                            if box >= best:
+                                continue
+                            d = linf_below(p0, p1, cz[o2 + i2], w0, w1, w2, r, box, best)
                         if d < best:
                             row[i2] = d
 

@@ -173,8 +173,8 @@ def distance_field(shape: Any, resolution: Union[int, tuple[int, int, int], None
     if spec.kernel.kind == "certified":
         spec.boxes = _surface_boxes(vox)
     kernel = spec.kernel
-    if mesh is not None and norm == "linf" and band is not None:
-        values_band, used = mesh_band_distances(mesh, grid, weights, keys, active, band,
+    if mesh is not None and band is not None:
+        values_band, used = mesh_band_distances(mesh, grid, norm, weights, keys, active, band,
                                                 run.part(0.2, 1.0))
         errors_band = np.zeros(len(values_band))
     else:

@@ -85,26 +85,28 @@ def triangle_linf(px, py, pz, wx, wy, wz, t):
 
 
 @njit(**COMPILE)
-def _segment(p, a, b):
-    """Euclidean distance from ``p`` to the segment ``a b`` (rows of ``t``)."""
+def _segment(p0, p1, p2, a, b):
+    """Euclidean distance from ``(p0, p1, p2)`` to the segment ``a b`` (rows of ``t``)."""
     d0, d1, d2 = b[0] - a[0], b[1] - a[1], b[2] - a[2]
     dd = d0 * d0 + d1 * d1 + d2 * d2
-    s = ((p[0] - a[0]) * d0 + (p[1] - a[1]) * d1 + (p[2] - a[2]) * d2) / dd if dd > 0 else 0.0
+    s = ((p0 - a[0]) * d0 + (p1 - a[1]) * d1 + (p2 - a[2]) * d2) / dd if dd > 0 else 0.0
     s = min(max(s, 0.0), 1.0)
-    x0 = p[0] - (a[0] + s * d0)
-    x1 = p[1] - (a[1] + s * d1)
-    x2 = p[2] - (a[2] + s * d2)
+    x0 = p0 - (a[0] + s * d0)
+    x1 = p1 - (a[1] + s * d1)
+    x2 = p2 - (a[2] + s * d2)
     return math.sqrt(x0 * x0 + x1 * x1 + x2 * x2)
 
 
 @njit(**COMPILE)
-def _triangle_euclidean(p, t):
+def triangle_euclidean(p0, p1, p2, t):
+    """Euclidean distance from ``(p0, p1, p2)`` to triangle ``t`` (3, 3), by the
+    closest point's region (Ericson, *Real-Time Collision Detection*, §5.1.5)."""
     a, b, c = t[0], t[1], t[2]
     ab0, ab1, ab2 = b[0] - a[0], b[1] - a[1], b[2] - a[2]
     ac0, ac1, ac2 = c[0] - a[0], c[1] - a[1], c[2] - a[2]
-    ap0, ap1, ap2 = p[0] - a[0], p[1] - a[1], p[2] - a[2]
-    bp0, bp1, bp2 = p[0] - b[0], p[1] - b[1], p[2] - b[2]
-    cp0, cp1, cp2 = p[0] - c[0], p[1] - c[1], p[2] - c[2]
+    ap0, ap1, ap2 = p0 - a[0], p1 - a[1], p2 - a[2]
+    bp0, bp1, bp2 = p0 - b[0], p1 - b[1], p2 - b[2]
+    cp0, cp1, cp2 = p0 - c[0], p1 - c[1], p2 - c[2]
     d1 = ab0 * ap0 + ab1 * ap1 + ab2 * ap2
     d2 = ac0 * ap0 + ac1 * ap1 + ac2 * ap2
     d3 = ab0 * bp0 + ab1 * bp1 + ab2 * bp2
@@ -114,22 +116,21 @@ def _triangle_euclidean(p, t):
     va = d3 * d6 - d5 * d4
     vb = d5 * d2 - d1 * d6
     vc = d1 * d4 - d3 * d2
-    best = min(min(_segment(p, a, b), _segment(p, b, c)), _segment(p, c, a))
+    best = min(min(_segment(p0, p1, p2, a, b), _segment(p0, p1, p2, b, c)),
+               _segment(p0, p1, p2, c, a))
     denom = va + vb + vc
     if va >= 0 and vb >= 0 and vc >= 0 and denom > 0:
         v, u = vb / denom, vc / denom
-        x0 = (a[0] + ab0 * v + ac0 * u) - p[0]
-        x1 = (a[1] + ab1 * v + ac1 * u) - p[1]
-        x2 = (a[2] + ab2 * v + ac2 * u) - p[2]
+        x0 = (a[0] + ab0 * v + ac0 * u) - p0
+        x1 = (a[1] + ab1 * v + ac1 * u) - p1
+        x2 = (a[2] + ab2 * v + ac2 * u) - p2
         best = min(math.sqrt(x0 * x0 + x1 * x1 + x2 * x2), best)
     return best
 
 
 @njit(**COMPILE)
-def triangle_euclidean(px, py, pz, t):
-    """Euclidean distance from ``(px, py, pz)`` to triangle ``t`` (3, 3), by the
-    closest point's region (Ericson, *Real-Time Collision Detection*, §5.1.5)."""
-    return _triangle_euclidean(np.array([px, py, pz]), t)
+def _triangle_euclidean(p, t):
+    return triangle_euclidean(p[0], p[1], p[2], t)
 
 
 @njit(**COMPILE)

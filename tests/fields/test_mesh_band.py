@@ -1,4 +1,4 @@
-"""The band's bricks and a mesh's max-norm band by scattered triangles, against oracles."""
+"""The band's bricks and a mesh's distance band by scattered triangles, against oracles."""
 from __future__ import annotations
 
 import numpy as np
@@ -47,10 +47,14 @@ def test_the_scattered_band_is_the_walk_bit_for_bit_on_any_number_of_threads():
     w = h / h.max()
     points = grid.centers(masked_coords(keys, active))
     walk = np.abs(mesh.distance(points, np.broadcast_to(w, points.shape)))
-    one = mesh_band(mesh, grid, keys, active, 3, w, workers=1)
+    one = mesh_band(mesh, grid, keys, active, 3, "linf", w, workers=1)
     assert np.array_equal(one, walk)
-    assert np.array_equal(mesh_band(mesh, grid, keys, active, 3, w, workers=2), one)
+    assert np.array_equal(mesh_band(mesh, grid, keys, active, 3, "linf", w, workers=2), one)
     assert one.max() <= 3.5 * h.max()
+    walk = np.abs(mesh.euclidean_distance(points))
+    one = mesh_band(mesh, grid, keys, active, 3, "euclidean", workers=1)
+    assert np.array_equal(one, walk)
+    assert np.array_equal(mesh_band(mesh, grid, keys, active, 3, "euclidean", workers=2), one)
 
 
 def test_samples_beyond_every_triangles_reach_are_walked():
@@ -58,6 +62,8 @@ def test_samples_beyond_every_triangles_reach_are_walked():
     everywhere = np.ones_like(active)          # far more than the band of 1 voxel
     w = np.asarray(grid.voxel_size) / max(grid.voxel_size)
     points = grid.centers(masked_coords(keys, everywhere))
-    got = mesh_band(mesh, grid, keys, everywhere, 1, w)
+    got = mesh_band(mesh, grid, keys, everywhere, 1, "linf", w)
     assert got.max() > 1.5 * max(grid.voxel_size)
     assert np.array_equal(got, np.abs(mesh.distance(points, np.broadcast_to(w, points.shape))))
+    got = mesh_band(mesh, grid, keys, everywhere, 1, "euclidean")
+    assert np.array_equal(got, np.abs(mesh.euclidean_distance(points)))
