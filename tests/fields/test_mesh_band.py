@@ -67,3 +67,17 @@ def test_samples_beyond_every_triangles_reach_are_walked():
     assert np.array_equal(got, np.abs(mesh.distance(points, np.broadcast_to(w, points.shape))))
     got = mesh_band(mesh, grid, keys, everywhere, 1, "euclidean")
     assert np.array_equal(got, np.abs(mesh.euclidean_distance(points)))
+
+
+@pytest.mark.parametrize("workers", [1, 2])
+def test_a_mesh_fields_progress_is_monotone_and_ends_at_one(workers, monkeypatch):
+    import implicitvox as iv
+    from implicitvox.fields import mesh_band as module
+    monkeypatch.setattr(module, "PIECE_PAIRS", 512)          # several pieces
+    seen = []
+    sphere = pv.Sphere(radius=1.0, theta_resolution=16, phi_resolution=12)
+    field = iv.distance_field(sphere, 40, norm="linf", band=2, workers=workers,
+                              progress=seen.append)
+    assert field.count
+    assert seen == sorted(seen) and seen[-1] == 1.0
+    assert len([s for s in seen if 0.2 < s < 1.0]) >= 2        # the scatter's own steps
