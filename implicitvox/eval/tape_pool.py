@@ -168,6 +168,17 @@ class TapePool:
                    + used[USED_KEYS] * self.keys.itemsize
                    + tables + self.scratch.nbytes + self.kept.nbytes)
 
+    @property
+    def rows_used(self) -> int:
+        """Rows the pool's tapes hold."""
+        return int(self.used[USED_ROWS])
+
+    @property
+    def ran_out(self) -> bool:
+        """Whether a run since the last :meth:`grow` found no room for a tape (its
+        octants kept their parents' tapes)."""
+        return bool(self.used[FULL])
+
     def lengths(self, tapes: np.ndarray) -> np.ndarray:
         """Rows of the pool tapes ``tapes``."""
         return self.tapes[tapes, ROWS]

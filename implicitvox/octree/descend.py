@@ -156,6 +156,11 @@ DERIVE_COST = 1
 #: keeps its parent's tape: the pool grows before the next call)
 TAPES_PER_CALL = 1 << 14
 ROWS_PER_CALL = 1 << 17
+#: until a call runs out of room, a call reserves at most this many times what the
+#: last one added (children multiply by 8 at most, and share most of their tapes),
+#: and at least room for :data:`RESERVE_TAPES` tapes
+RESERVE_GROWTH = 16
+RESERVE_TAPES = 64
 
 
 def warm_up() -> None:
@@ -337,6 +342,26 @@ class Descent:
             raise ValueError(f"grids of at most {2 * MAX_SIDE - 1} voxels a side, "
                              f"not {grid.shape}")
         self.pool, self.grid = pool, grid
+        #: rows and tapes the last call added to the pool, and whether a call has run
+        #: out of room (:meth:`children` reserves by them)
+        self.added = (0, 0)
+        self.filled = False
+
+    def _reserve(self, m: int, mean_rows: int) -> tuple[int, int]:
+        """The tapes and rows to make room for before a call on ``m`` parents whose
+        tapes have ``mean_rows`` rows: at most one new tape per child
+        (:data:`TAPES_PER_CALL`, :data:`ROWS_PER_CALL` at most), but, until a call
+        has run out of room, no more than :data:`RESERVE_GROWTH` times what the last
+        call added: children share tapes, and a pool reserved for the worst case
+        costs its pages (a 13 MiB copy per descent, a quarter of a small model's
+        time). A call that runs out keeps the parents' tapes for the rest (the
+        same voxels), and the next reserves for the worst case."""
+        tapes = min(8 * m, TAPES_PER_CALL)
+        rows = min(8 * m * mean_rows, ROWS_PER_CALL)
+        if not self.filled:
+            tapes = min(tapes, max(RESERVE_GROWTH * self.added[1], RESERVE_TAPES))
+            rows = min(rows, max(RESERVE_GROWTH * self.added[0], RESERVE_TAPES * mean_rows))
+        return tapes, rows
 
     @functools.lru_cache(maxsize=64)
     def _edges(self, level: int) -> tuple:
@@ -381,8 +406,9 @@ class Descent:
             return order, state, flo, fhi, child_tapes, suspects, 8 * m
         mean_rows = int(pool.lengths(tapes[:64]).mean()) if m else 0
         derives = prune and pool.branches > 0
-        pool.grow(tapes=min(8 * m, TAPES_PER_CALL) if derives else 0,
-                  rows=min(8 * m * mean_rows, ROWS_PER_CALL) if derives else 0)
+        if derives:
+            pool.grow(*self._reserve(m, mean_rows))
+        before = (pool.rows_used, len(pool))
         used = len(pool)
         registers = int(pool.tapes[:used, REGISTERS].max())
         rows = int(pool.tapes[:used, ROWS].max())
@@ -403,6 +429,8 @@ class Descent:
                                pool.params, pool.constant_lo, pool.constant_hi,
                                pool.is_constant, pool.inputs, *pool.arrays(),
                                order, state, flo, fhi, child_tapes, suspects, *buffers)
+        self.added = (pool.rows_used - before[0], len(pool) - before[1])
+        self.filled |= pool.ran_out
         return order, state, flo, fhi, child_tapes, suspects, int(classified)
 
 

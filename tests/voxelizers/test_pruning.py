@@ -148,3 +148,34 @@ def test_subtrees_continue_on_the_heads_pruned_tapes(carry):
         joined = np.concatenate(interior[lvl])
         assert np.array_equal(joined[np.lexsort(joined.T[::-1])], c[np.lexsort(c.T[::-1])])
     assert len(pool) == before[0] and np.array_equal(pool.rows[:pool.used[0]], before[1])
+
+
+def _pool_sizes(monkeypatch) -> list:
+    """Record, after each call of the compiled descent, whether it has run out of room
+    and the rows its pool holds."""
+    seen = []
+    original = descend.Descent.children
+
+    def spy(self, *args, **kwargs):
+        out = original(self, *args, **kwargs)
+        seen.append((self.filled, len(self.pool.rows)))
+        return out
+    monkeypatch.setattr(descend.Descent, "children", spy)
+    return seen
+
+
+def test_a_small_model_keeps_a_small_tape_pool(monkeypatch):
+    seen = _pool_sizes(monkeypatch)
+    solid = (Box((1.0, 1.0, 1.0), center=True) | Sphere(0.6, center=(0.5, 0.0, 0.0))) \
+        - Cylinder(h=2.0, r=0.2, center=True)
+    _both(solid, 128)
+    assert seen and not any(filled for filled, _ in seen)
+    assert max(rows for _, rows in seen) <= 1 << 14
+
+
+def test_a_pool_that_runs_out_gives_the_same_voxels(monkeypatch):
+    monkeypatch.setattr(descend, "RESERVE_TAPES", 1)
+    monkeypatch.setattr(descend, "RESERVE_GROWTH", 1)
+    seen = _pool_sizes(monkeypatch)
+    _both(sphere_union(40), 64, interior=True, normals=True)
+    assert any(filled for filled, _ in seen)
