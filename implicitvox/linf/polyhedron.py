@@ -178,6 +178,24 @@ class ConvexPolyhedron(Primitive):
     def _distance(self, p: np.ndarray, w: np.ndarray) -> np.ndarray:
         if self._axis_aligned is not None:
             return self._box_distance(p, w)
+        from .polyhedron_kernels import convex_distances     # (loads Numba: not at import)
+        out = np.empty(len(p))
+        convex_distances(np.ascontiguousarray(p, dtype=np.float64),
+                         np.ascontiguousarray(np.broadcast_to(w, p.shape), dtype=np.float64),
+                         self.normals, self.offsets, self.half_axes, self.low_plus,
+                         self.low_minus, out)
+        return out
+
+    def distance_by_arrays(self, points: Any, weights: Any = None) -> np.ndarray:
+        """:meth:`distance` in array code (whole-array numpy over the faces and axes):
+        the oracle its compiled kernel
+        (:func:`implicitvox.linf.polyhedron_kernels.convex_distances`) is tested
+        against."""
+        p = as_points(points)
+        w = as_weights(weights, len(p))
+        return in_blocks(self._array_distance, p, w, CHUNK)
+
+    def _array_distance(self, p: np.ndarray, w: np.ndarray) -> np.ndarray:
         slack = self.offsets[None, :] - dot(p, self.normals.T)             # (n, F), >= 0 inside
         inside = np.all(slack >= 0, axis=1)
         # the octants of one level share their half-widths: the reach of the box

@@ -177,6 +177,22 @@ def test_a_triangles_projected_axes_give_its_distance_below_any_bound():
         assert got == truth[k] if truth[k] < bounds[k] else got >= bounds[k]
 
 
+def test_the_compiled_convex_distance_is_the_array_paths_bit_for_bit():
+    rng = np.random.default_rng(11)
+    tiny = np.finfo(np.float64).tiny
+    for _ in range(40):
+        pts = rng.normal(size=(int(rng.integers(4, 40)), 3))
+        solid = linf.ConvexPolyhedron.from_points(pts)
+        p = rng.normal(size=(400, 3)) * 2
+        p[::29] = pts[0]                                          # on a vertex
+        w = rng.uniform(0.1, 3.0, (400, 3))
+        w[::17] = tiny                                            # a flat box's weights
+        w[::19, 1] = tiny
+        with np.errstate(all="ignore"):
+            got, truth = solid.distance(p, w), solid.distance_by_arrays(p, w)
+        assert np.array_equal(got, truth, equal_nan=True)
+
+
 def _brute_classify_sphere(c, r, lo, hi):
     """A box against a sphere's surface, Euclidean: the nearest and farthest box points."""
     near = np.linalg.norm(np.maximum(np.maximum(lo - c, c - hi), 0), axis=1)
