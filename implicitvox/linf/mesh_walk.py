@@ -58,16 +58,6 @@ MAX_CANDIDATES = 4096
 
 
 @njit(**COMPILE)
-def _fmax(a, b):
-    """numpy's fmax: the larger, NaN ignored."""
-    if a != a:
-        return b
-    if b != b:
-        return a
-    return a if a >= b else b
-
-
-@njit(**COMPILE)
 def _linf(p, w, r, bound):
     """The weighted max-norm distance from ``p`` to the triangle of row ``r`` where it
     is below ``bound`` (:func:`implicitvox.linf.triangle_axes.linf_below`)."""
