@@ -63,7 +63,8 @@ __all__ = ["mesh_band", "brick_triangles", "PIECE_PAIRS"]
 
 #: brick-triangle pairs per piece handed to a thread (progress steps, balance)
 PIECE_PAIRS = 1 << 16
-#: the reach's allowance for rounding, in voxels (coordinates have at most 21 bits)
+#: the reach's allowance for rounding, relative and in voxels (far above the rounding of
+#: coordinates of at most 21 bits)
 _SLACK = 1e-6
 
 
@@ -72,41 +73,46 @@ def _kernels():
     return mesh_band_kernels
 
 
-def brick_triangles(rows: np.ndarray, keys: np.ndarray, grid: Grid, reach: np.ndarray
+def brick_triangles(rows: np.ndarray, keys: np.ndarray, grid: Grid, margin: np.ndarray
                     ) -> tuple[np.ndarray, np.ndarray]:
     """Per brick of ``keys``, the triangles (rows of
     :func:`~implicitvox.linf.triangle_axes.axis_rows`) whose bounding box grown by
-    ``reach`` (per axis, world units) holds a sample of the brick, nearest to the
-    brick's centre first: ``(start, triangles)``, brick ``b``'s in
+    ``margin`` (per axis, world units) holds a sample of the brick, nearest to the
+    brick's middle first: ``(start, triangles)``, brick ``b``'s in
     ``triangles[start[b]:start[b + 1]]``."""
+    origins, centres = _layout(keys, grid)
+    return _kernels().brick_triangles(rows, keys, origins, centres,
+                                      np.asarray(margin, dtype=float))
+
+
+def _layout(keys: np.ndarray, grid: Grid) -> tuple[np.ndarray, tuple]:
+    """Each brick's first voxel index (k, 3), and the samples' coordinates per axis
+    (the grid's one centre formula)."""
     origins = morton.decode(keys).astype(np.int64) * BRICK
-    kernels = _kernels()
-    return kernels.brick_triangles(rows, keys, origins, np.asarray(grid.origin, dtype=float),
-                                   np.asarray(grid.voxel_size, dtype=float),
-                                   np.asarray(grid.shape, dtype=np.int64),
-                                   np.asarray(reach, dtype=float), _SLACK)
+    centres = tuple(0.5 * (grid.edge(a, np.arange(grid.shape[a]))
+                           + grid.edge(a, np.arange(grid.shape[a]) + 1)) for a in range(3))
+    return origins, centres
 
 
 class _BandJob(Job):
     """The triangles, bricks and grid every range of bricks shares (threads)."""
 
     def __init__(self, mesh: TriangleMesh, grid: Grid, keys: np.ndarray, active: np.ndarray,
-                 weights: np.ndarray, reach: np.ndarray, euclidean: bool):
+                 weights: np.ndarray, margin: np.ndarray, euclidean: bool):
         super().__init__()
         self.mesh, self.grid, self.active, self.weights = mesh, grid, active, weights
-        self.reach, self.euclidean = reach, euclidean
-        self.origins = morton.decode(keys).astype(np.int64) * BRICK
-        self.start, self.triangles = brick_triangles(mesh.axes, keys, grid, reach)
-        self.centres = [0.5 * (grid.edge(a, np.arange(grid.shape[a]))
-                               + grid.edge(a, np.arange(grid.shape[a]) + 1)) for a in range(3)]
+        self.margin, self.euclidean = margin, euclidean
+        self.origins, self.centres = _layout(keys, grid)
+        self.start, self.triangles = _kernels().brick_triangles(mesh.axes, keys, self.origins,
+                                                                self.centres, margin)
 
     def run(self, piece: tuple[int, int]) -> np.ndarray:
         """The least values of bricks ``piece[0]`` to ``piece[1]``: (bricks, 8, 8, 8)."""
         b0, b1 = piece
         values = np.where(self.active[b0:b1], np.inf, -np.inf)
         _kernels().scatter_bricks(b0, b1, self.start, self.triangles, self.mesh.axes,
-                                  self.mesh.tri, self.origins, *self.centres, self.weights,
-                                  self.reach, self.euclidean, values)
+                                  self.mesh.tri, self.origins, self.centres, self.weights,
+                                  self.margin, self.euclidean, values)
         return values
 
 
@@ -149,8 +155,8 @@ def mesh_band(mesh: TriangleMesh, grid: Grid, keys: np.ndarray, active: np.ndarr
     # (band + 1/2) voxels per axis; the nearest point lies that far per axis (max norm,
     # weighted) or that offset's length along any axis (Euclidean)
     limit = (band + 0.5) * (float(np.linalg.norm(h)) if euclidean else float(h.max()))
-    reach = (np.full(3, limit) if euclidean else (band + 0.5) * h) * (1 + _SLACK)
-    job = _BandJob(mesh, grid, keys, active, w, reach, euclidean)
+    reach = np.full(3, limit) if euclidean else (band + 0.5) * h
+    job = _BandJob(mesh, grid, keys, active, w, reach * (1 + _SLACK) + _SLACK * h, euclidean)
     pieces = _pieces(job.start)
     values = np.empty(active.shape)
     if workers > 1 or executor is not None:

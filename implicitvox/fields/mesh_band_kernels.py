@@ -2,8 +2,6 @@
 """
 from __future__ import annotations
 
-import math
-
 import numpy as np
 from numba import njit
 
@@ -12,22 +10,22 @@ from ..linf.mesh_walk import EUCLIDEAN_SLACK, triangle_euclidean
 from ..linf.triangle_axes import box_side, linf_below
 from .brick_kernels import BRICK, brick_row
 
-__all__ = ["brick_triangles", "scatter_bricks"]
+__all__ = ["centre_range", "brick_triangles", "scatter_bricks"]
 
 _BITS = 3
 
 
 @njit(**COMPILE)
-def _sample_range(lo, hi, origin, h, reach, slack, size):
-    """The voxels whose centres lie within ``reach`` of ``[lo, hi]`` on one axis (a
-    few millionths of a voxel more), clipped to ``0 .. size - 1``."""
-    first = math.ceil((lo - reach - origin) / h - 0.5 - slack)
-    last = math.floor((hi + reach - origin) / h - 0.5 + slack)
-    return max(first, 0), min(last, size - 1)
+def centre_range(lo, hi, centres, margin):
+    """``(first, last)``: the samples whose centres (sorted) lie within ``margin`` of
+    ``[lo, hi]`` on one axis (none when ``first > last``)."""
+    first = np.searchsorted(centres, lo - margin)
+    last = np.searchsorted(centres, hi + margin, side="right") - 1
+    return first, last
 
 
 @njit(**COMPILE)
-def _each_pair(rows, keys, origin, h, shape, reach, slack, count, start, triangles):
+def _each_pair(rows, keys, centres, margin, count, start, triangles):
     """Every (brick, triangle) pair: counted into ``count``, or, given ``start``,
     written to ``triangles`` (``start`` advanced as they go)."""
     lo = np.empty(3, dtype=np.int64)
@@ -35,8 +33,7 @@ def _each_pair(rows, keys, origin, h, shape, reach, slack, count, start, triangl
     for t in range(rows.shape[0]):
         empty = False
         for a in range(3):
-            first, last = _sample_range(rows[t, a], rows[t, 3 + a], origin[a], h[a], reach[a],
-                                        slack, shape[a])
+            first, last = centre_range(rows[t, a], rows[t, 3 + a], centres[a], margin[a])
             lo[a], hi[a] = first >> _BITS, last >> _BITS
             empty = empty or first > last
         if empty:
@@ -55,27 +52,31 @@ def _each_pair(rows, keys, origin, h, shape, reach, slack, count, start, triangl
 
 
 @njit(**COMPILE)
-def brick_triangles(rows, keys, origins, origin, h, shape, reach, slack):
+def brick_triangles(rows, keys, origins, centres, margin):
     """:func:`implicitvox.fields.mesh_band.brick_triangles` (``origins``: each brick's
-    first voxel index)."""
+    first voxel index; ``centres``: the samples' coordinates per axis)."""
     n = keys.size
     count = np.zeros(n, dtype=np.int64)
     none = np.zeros(0, dtype=np.int64)
-    _each_pair(rows, keys, origin, h, shape, reach, slack, count, none, none)
+    _each_pair(rows, keys, centres, margin, count, none, none)
     start = np.zeros(n + 1, dtype=np.int64)
     start[1:] = np.cumsum(count)
     cursor = start[:-1].copy()
     triangles = np.empty(start[n], dtype=np.int64)
-    _each_pair(rows, keys, origin, h, shape, reach, slack, none, cursor, triangles)
-    for b in range(n):                     # nearest to the brick's centre first
+    _each_pair(rows, keys, centres, margin, none, cursor, triangles)
+    middle = np.empty(3)
+    for b in range(n):                     # nearest to the brick's middle first
+        for a in range(3):
+            c = centres[a]
+            o = origins[b, a]
+            middle[a] = 0.5 * (c[o] + c[min(o + BRICK - 1, c.size - 1)])
         s, e = start[b], start[b + 1]
         gaps = np.empty(e - s)
         for j in range(s, e):
             t = triangles[j]
             gap = 0.0
             for a in range(3):
-                c = origin[a] + (origins[b, a] + 0.5 * BRICK) * h[a]
-                gap = max(gap, max(rows[t, a] - c, c - rows[t, 3 + a]) / h[a])
+                gap = max(gap, max(rows[t, a] - middle[a], middle[a] - rows[t, 3 + a]))
             gaps[j - s] = gap
         triangles[s:e] = triangles[s:e][np.argsort(gaps, kind="mergesort")]
     return start, triangles
@@ -91,16 +92,16 @@ def _side(r, a, p, w, euclidean):
 
 
 @njit(**COMPILE)
-def scatter_bricks(b0, b1, start, triangles, rows, tri, origins, cx, cy, cz, w, reach,
+def scatter_bricks(b0, b1, start, triangles, rows, tri, origins, centres, w, margin,
                    euclidean, values):
     """Bricks ``b0`` to ``b1``: each listed triangle's exact distance (max-norm, or
     Euclidean), where below the value held, into ``values[b - b0]`` at the samples
-    within ``reach`` of its box (samples to skip hold -inf). A triangle whose box
+    within ``margin`` of its box (samples to skip hold -inf). A triangle whose box
     lies farther than the value held is skipped (the Euclidean box a relative
     :data:`~implicitvox.linf.mesh_walk.EUCLIDEAN_SLACK` farther: its distance and
     the triangle's round differently)."""
-    slack = 1e-6
     keep = 1.0 + EUCLIDEAN_SLACK
+    cx, cy, cz = centres
     w0, w1, w2 = w[0], w[1], w[2]
     sides = np.empty(BRICK)
     for b in range(b0, b1):
@@ -110,9 +111,9 @@ def scatter_bricks(b0, b1, start, triangles, rows, tri, origins, cx, cy, cz, w, 
             t = triangles[j]
             r = rows[t]
             # the brick's samples within reach of the triangle's box, per axis
-            f0, l0 = _local_range(r[0], r[3], cx, o0, reach[0], slack)
-            f1, l1 = _local_range(r[1], r[4], cy, o1, reach[1], slack)
-            f2, l2 = _local_range(r[2], r[5], cz, o2, reach[2], slack)
+            f0, l0 = _local_range(r[0], r[3], cx, o0, margin[0])
+            f1, l1 = _local_range(r[1], r[4], cy, o1, margin[1])
+            f2, l2 = _local_range(r[2], r[5], cz, o2, margin[2])
             for i2 in range(f2, l2 + 1):
                 sides[i2] = _side(r, 2, cz[o2 + i2], w2, euclidean)
             for i0 in range(f0, l0 + 1):
@@ -142,18 +143,6 @@ def scatter_bricks(b0, b1, start, triangles, rows, tri, origins, cx, cy, cz, w, 
 
 
 @njit(**COMPILE)
-def _local_range(lo, hi, centres, o, reach, slack):
-    """The samples ``o .. o + 7`` (offsets) whose centres lie within ``reach`` of
-    ``[lo, hi]``, from the centres themselves (a slack of ``slack`` voxels)."""
-    size = centres.size
-    h = centres[1] - centres[0] if size > 1 else 1.0
-    margin = reach + slack * abs(h)
-    first, last = BRICK, -1
-    for i in range(BRICK):
-        if o + i >= size:
-            break
-        c = centres[o + i]
-        if c >= lo - margin and c <= hi + margin:
-            first = min(first, i)
-            last = i
-    return first, last
+def _local_range(lo, hi, centres, o, margin):
+    """:func:`centre_range` among the brick's samples ``o .. o + 7`` (offsets)."""
+    return centre_range(lo, hi, centres[o:o + BRICK], margin)
