@@ -11,28 +11,14 @@ import numpy as np
 from numba import njit
 
 from ..interval.rules import COMPILE
+from ..octree.morton_kernels import encode_one
 
 __all__ = ["brick_code", "brick_row", "band_samples", "BRICK"]
 
 #: samples per brick edge (as :data:`implicitvox.fields.bricks.BRICK`)
 BRICK = 8
-
-
-@njit(**COMPILE)
-def _spread(v):
-    """The bits of ``v`` (21 at most) two places apart: one axis of a Morton code."""
-    v = np.uint64(v) & np.uint64(0x1FFFFF)
-    v = (v | (v << np.uint64(32))) & np.uint64(0x1F00000000FFFF)
-    v = (v | (v << np.uint64(16))) & np.uint64(0x1F0000FF0000FF)
-    v = (v | (v << np.uint64(8))) & np.uint64(0x100F00F00F00F00F)
-    v = (v | (v << np.uint64(4))) & np.uint64(0x10C30C30C30C30C3)
-    return (v | (v << np.uint64(2))) & np.uint64(0x1249249249249249)
-
-
-@njit(**COMPILE)
-def brick_code(i, j, k):
-    """:func:`implicitvox.octree.morton.encode` of one index ``(i, j, k)``."""
-    return _spread(i) | (_spread(j) << np.uint64(1)) | (_spread(k) << np.uint64(2))
+#: :func:`implicitvox.octree.morton.encode` of one index ``(i, j, k)``
+brick_code = encode_one
 
 
 @njit(**COMPILE)

@@ -52,6 +52,7 @@ from ..eval.function import Function
 from ..expr.shape import AMBIGUOUS, EMPTY, FULL, Octants
 from ..interval.rules import COMPILE
 from .grid import Grid
+from .morton_kernels import compact
 from .guard import MemoryGuard
 from .octants import (MAX_SIDE, RECHECK, ROOT_CODE, Progress, PrunedTapes, Subdivision,
                       TapeRuns, classify_root, pack, tighten, unpack)
@@ -441,18 +442,6 @@ def _subtree_boxes(levels: int) -> int:
 
 
 @njit(**COMPILE)
-def _compact(v):
-    """Every third bit of ``v`` (from bit 0), packed: one axis of a Morton code."""
-    v = v & np.uint64(0x1249249249249249)
-    v = (v ^ (v >> np.uint64(2))) & np.uint64(0x10C30C30C30C30C3)
-    v = (v ^ (v >> np.uint64(4))) & np.uint64(0x100F00F00F00F00F)
-    v = (v ^ (v >> np.uint64(8))) & np.uint64(0x1F0000FF0000FF)
-    v = (v ^ (v >> np.uint64(16))) & np.uint64(0x1F00000000FFFF)
-    v = (v ^ (v >> np.uint64(32))) & np.uint64(0x1FFFFF)
-    return np.int64(v)
-
-
-@njit(**COMPILE)
 def _classify(xlo, xhi, ylo, yhi, zlo, zhi, limits, parents, tapes, prune,
               subtree, derive_cost, recheck, params, constant_lo, constant_hi, is_constant, inputs,
               rows, tapes_, derivations, contents, keys, used, masks, domain, fixed, scratch, kept,
@@ -472,9 +461,9 @@ def _classify(xlo, xhi, ylo, yhi, zlo, zhi, limits, parents, tapes, prune,
         n = e - k
         for q in range(n):
             code = parents[order[k + q]]
-            ci[q] = _compact(code)
-            cj[q] = _compact(code >> np.uint64(1))
-            ck[q] = _compact(code >> np.uint64(2))
+            ci[q] = compact(code)
+            cj[q] = compact(code >> np.uint64(1))
+            ck[q] = compact(code >> np.uint64(2))
         # the fixed registers: constants, then the children's boxes
         for f in range(fixed):
             if is_constant[f]:
