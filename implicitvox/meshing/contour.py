@@ -10,9 +10,10 @@ edges on their common face, and its quads become triangles (Varadhan §6.3
 contours the same way). The polygon is oriented so that its normal points
 from ``f < 0`` to ``f >= 0`` along the edge: outward.
 
-All of it is array code over every edge at once: the cells around an edge
-are found by locating four probe points (beside the edge's midpoint, one in
-each quadrant around it) among the sorted Morton codes of each level.
+The loops over edges are compiled (:mod:`.contour_kernels`): each distinct edge is
+found once (a hash of its start, axis and length), and the cells around it by
+locating four probe points (beside the edge's midpoint, one in each quadrant
+around it) among the leaves' runs of finest-level Morton codes.
 
 Examples
 --------
@@ -40,12 +41,7 @@ from .adaptive import AdaptiveGrid, per_tape
 from .edges import crossings
 from .qef import solve
 
-__all__ = ["Contour", "dual_contour", "EDGES"]
-
-#: the 12 cell edges as (start corner, end corner, axis), the start the lower end
-EDGES = np.array([(c, c | (1 << a), a) for a in range(3) for c in range(8) if not (c >> a) & 1],
-                 dtype=np.int64)
-
+__all__ = ["Contour", "dual_contour"]
 
 @dataclass
 class Contour:
@@ -80,11 +76,11 @@ class _Locator:
     """The leaf that holds a finest-level cell: the leaves are disjoint runs of the
     finest level's Morton codes (a leaf at level ``l`` covers ``8**(depth - l)``
     of them from its first), so one binary search over the runs' starts finds
-    it, whatever its level."""
+    it, whatever its level (compiled: :func:`.contour_kernels.find_leaf`)."""
 
     def __init__(self, agrid: AdaptiveGrid):
         self.depth = agrid.grid.depth
-        self.shape = np.asarray(agrid.grid.shape)
+        self.shape = np.asarray(agrid.grid.shape, dtype=np.int64)
         shift = (3 * (self.depth - agrid.levels.astype(np.int64))).astype(np.uint64)
         starts = morton.encode(agrid.coords) << shift
         order = np.argsort(starts, kind="stable")
@@ -93,36 +89,20 @@ class _Locator:
         self.index = order
         self.levels = agrid.levels.astype(np.int64)[order]
 
-    def _codes(self, fine: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        inside = ((fine >= 0) & (fine < self.shape)).all(1)
-        return morton.encode(np.where(inside[:, None], fine, 0)), inside
-
-    def split(self, fine: np.ndarray, level: np.ndarray) -> np.ndarray:
-        """Whether the cell at ``level`` holding finest-level cell ``fine`` has
-        leaves below it (it was split): a leaf deeper than ``level`` starts in
-        its run of finest codes."""
-        shift = (3 * (self.depth - np.asarray(level, dtype=np.int64))).astype(np.uint64)
-        codes = morton.encode(np.maximum(fine, 0))        # past the grid: no leaf there
-        first = (codes >> shift) << shift
-        lo = np.searchsorted(self.starts, first, side="left")
-        hi = np.searchsorted(self.starts, first + (np.uint64(1) << shift), side="left")
-        count = hi - lo
-        deeper = np.zeros(len(fine), dtype=bool)
-        one = count == 1
-        deeper[one] = self.levels[lo[one]] > np.asarray(level)[one]
-        return (count >= 2) | deeper
-
     def find(self, fine: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Leaf index and level (-1 where none) of finest-level cells ``fine`` (n, 3)."""
-        codes, inside = self._codes(fine)
-        at = np.searchsorted(self.starts, codes, side="right") - 1
-        hit = inside & (at >= 0)
-        hit[hit] = codes[hit] < self.ends[at[hit]]
-        found = np.full(len(fine), -1, dtype=np.int64)
-        level_of = np.full(len(fine), -1, dtype=np.int64)
-        found[hit] = self.index[at[hit]]
-        level_of[hit] = self.levels[at[hit]]
-        return found, level_of
+        from .contour_kernels import find_leaves          # (loads Numba)
+        at = find_leaves(self.starts, self.ends, self.shape,
+                         np.ascontiguousarray(fine, dtype=np.int64))
+        hit = at >= 0
+        return (np.where(hit, self.index[at], -1), np.where(hit, self.levels[at], -1))
+
+    def edge_cells(self, start: np.ndarray, axis: np.ndarray, length: np.ndarray
+                   ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """:func:`.contour_kernels.edge_cells` over these leaves."""
+        from .contour_kernels import edge_cells           # (loads Numba)
+        return edge_cells(start, axis, length, self.starts, self.ends, self.index,
+                          self.levels, self.shape, self.depth)
 
 
 def dual_contour(func: Function, agrid: AdaptiveGrid, bound: float = np.inf,
@@ -131,83 +111,50 @@ def dual_contour(func: Function, agrid: AdaptiveGrid, bound: float = np.inf,
     ``bound`` (Euclidean) is the distance a complex leaf's points may be from
     the nearest vertex of a leaf around it (:attr:`Contour.uncovered`);
     ``progress`` is called with the share done after each stage."""
+    from .contour_kernels import changed_edges, unique_edges    # (loads Numba)
     share = progress if progress is not None else (lambda s: None)
     grid, depth = agrid.grid, agrid.grid.depth
     n = agrid.count
-    inside = agrid.corners < 0
+    # every (leaf, edge) with a sign change, and each distinct edge once (up to four
+    # leaves list it): its crossing is found once
+    leaf, start, axis, length, low_inside = changed_edges(
+        np.ascontiguousarray(agrid.corners, dtype=np.float64), agrid.levels,
+        np.ascontiguousarray(agrid.coords, dtype=np.int64), depth)
+    first, edge_of, code = unique_edges(start, axis, length)
+    e_start, e_axis, e_length = start[first], axis[first], length[first]
+    e_end = e_start.copy()
+    e_end[np.arange(len(first)), e_axis] += e_length
+    a_pos = np.stack([grid.edge(k, e_start[:, k]) for k in range(3)], 1)
+    b_pos = np.stack([grid.edge(k, e_end[:, k]) for k in range(3)], 1)
+    p, nrm = per_tape(agrid.tapes, agrid.tape_index[leaf[first]],
+                      lambda tape, a, b: crossings(tape, a, b), a_pos, b_pos)
     scale = np.left_shift(1, depth - agrid.levels.astype(np.int64))       # cell size, fine units
-    # every (leaf, edge) with a sign change
-    change = inside[:, EDGES[:, 0]] != inside[:, EDGES[:, 1]]               # (n, 12)
-    leaf, which = np.nonzero(change)
-    start_corner, end_corner, axis = EDGES[which].T
-    origin = agrid.coords[leaf] * scale[leaf, None]                        # fine units
-    a_idx = origin + CORNERS[start_corner] * scale[leaf, None]
-    b_idx = origin + CORNERS[end_corner] * scale[leaf, None]
-    # each edge bisected once, though up to four cells list it
-    code = morton.encode(a_idx)
-    length = scale[leaf]
-    points = np.empty((len(leaf), 3))
-    normals = np.empty((len(leaf), 3))
-    for a in range(3):
-        for size in np.unique(length):
-            rows = np.flatnonzero((axis == a) & (length == size))
-            _, first, back = np.unique(code[rows], return_index=True, return_inverse=True)
-            one = rows[first]
-            a_pos = np.stack([grid.edge(k, a_idx[one, k]) for k in range(3)], 1)
-            b_pos = np.stack([grid.edge(k, b_idx[one, k]) for k in range(3)], 1)
-            p, nrm = per_tape(agrid.tapes, agrid.tape_index[leaf[one]],
-                              lambda tape, a, b: crossings(tape, a, b), a_pos, b_pos)
-            points[rows], normals[rows] = p[back.ravel()], nrm[back.ravel()]
     lo = np.stack([grid.edge(k, agrid.coords[:, k] * scale) for k in range(3)], 1)
     hi = np.stack([grid.edge(k, np.minimum((agrid.coords[:, k] + 1) * scale, grid.shape[k]))
                    for k in range(3)], 1)
-    vertex = solve(leaf, points, normals, n, lo, hi)
+    vertex = solve(leaf, p[edge_of], nrm[edge_of], n, lo, hi)
     share(0.6)
     # the cells around each edge: probes beside its midpoint, one per quadrant
     locator = _Locator(agrid)
-    u, v = (axis + 1) % 3, (axis + 2) % 3
-    rows = np.arange(len(leaf))
-    around = np.empty((len(leaf), 4), dtype=np.int64)
-    around_level = np.empty((len(leaf), 4), dtype=np.int64)
-    probes = []
-    for q, (du, dv) in enumerate(((-1, -1), (0, -1), (0, 0), (-1, 0))):    # counter-clockwise
-        fine = a_idx.copy()
-        fine[rows, axis] += scale[leaf] // 2
-        fine[rows, u] += du
-        fine[rows, v] += dv
-        around[:, q], around_level[:, q] = locator.find(fine)
-        probes.append(fine)
-    level = agrid.levels[leaf].astype(np.int64)
-    complete = (around >= 0).all(1)
-    minimal = complete & (around_level <= level[:, None]).all(1)
-    # an edge with a cell around it missing, not because a finer neighbour split it
-    unmatched_edges = ~complete & (around_level <= level[:, None]).all(1)
-    for q in range(4):
-        rows = np.flatnonzero(unmatched_edges & (around[:, q] < 0))
-        unmatched_edges[rows[locator.split(probes[q][rows], level[rows])]] = False
-    # one polygon per minimal edge, though every cell around it lists it
-    chosen = np.concatenate([_first_of_each(code, minimal & (axis == a)) for a in range(3)])
-    n_unmatched = sum(len(_first_of_each(code, unmatched_edges & (axis == a))) for a in range(3))
+    around, minimal, unmatched = locator.edge_cells(e_start, e_axis, e_length)
+    # polygons in the order of their edges' axes, then Morton codes
+    chosen = np.flatnonzero(minimal)
+    chosen = chosen[np.lexsort((code[chosen], e_axis[chosen]))]
+    loose = np.flatnonzero(unmatched)
+    n_unmatched = len(np.unique(np.stack([code[loose], e_axis[loose].astype(np.uint64)]),
+                                axis=1).T) if len(loose) else 0
     share(0.85)
     quads = around[chosen]
-    flip = ~inside[leaf[chosen], start_corner[chosen]]      # f >= 0 at the lower end: normal -axis
+    flip = ~low_inside[first[chosen]]             # f >= 0 at the lower end: normal -axis
     quads[flip] = quads[flip][:, ::-1]
     faces = _triangles(quads, vertex)
-    used, faces = np.unique(faces.ravel(), return_inverse=True)
     has_vertex = np.zeros(n, dtype=bool)
-    has_vertex[used] = True
+    has_vertex[faces.ravel()] = True
+    used = np.flatnonzero(has_vertex)
+    renumber = np.cumsum(has_vertex) - 1
     uncovered = _uncovered(agrid, locator, vertex, has_vertex, lo, hi, bound)
-    return Contour(vertex[used], faces.reshape(-1, 3).astype(np.int64), used, uncovered,
-                   int(n_unmatched))
-
-
-def _first_of_each(code: np.ndarray, mask: np.ndarray) -> np.ndarray:
-    """Indices (into ``code``) of the first row of each distinct code among ``mask``."""
-    rows = np.flatnonzero(mask)
-    _, first = np.unique(code[rows], return_index=True)
-    return rows[first]
-
-
+    return Contour(vertex[used], renumber[faces].reshape(-1, 3).astype(np.int64), used,
+                   uncovered, int(n_unmatched))
 
 
 def _uncovered(agrid: AdaptiveGrid, locator: "_Locator", vertex: np.ndarray,

@@ -32,26 +32,16 @@ Examples
 from __future__ import annotations
 
 import numpy as np
-from ..lazy import LazyModule
-
-#: scipy's sparse graphs, loaded on first use (``import implicitvox`` stays light)
-sparse = LazyModule("scipy.sparse")
-csgraph = LazyModule("scipy.sparse.csgraph")
-
 __all__ = ["split_nonmanifold", "edge_counts"]
 
 
 def edge_counts(faces: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Undirected edges ``(e, 2)`` (sorted ends), the triangle-edge incidence's
-    edge index ``(3 f,)`` (edge ``k`` of triangle ``t`` at ``3 t + k``, from
-    corner ``k`` to corner ``k + 1``) and each edge's triangle count."""
-    ends = np.stack([faces, np.roll(faces, -1, axis=1)], -1).reshape(-1, 2).astype(np.int64)
-    ends.sort(axis=1)
-    base = int(ends.max()) + 1 if len(ends) else 1
-    key, inverse, counts = np.unique(ends[:, 0] * base + ends[:, 1], return_inverse=True,
-                                     return_counts=True)
-    edges = np.stack([key // base, key % base], 1)
-    return edges, inverse.ravel(), counts
+    """Undirected edges ``(e, 2)`` (sorted ends, in the order they first appear), the
+    triangle-edge incidence's edge index ``(3 f,)`` (edge ``k`` of triangle ``t``
+    at ``3 t + k``, from corner ``k`` to corner ``k + 1``) and each edge's triangle
+    count (compiled: :func:`.manifold_kernels.edge_table`)."""
+    from .manifold_kernels import edge_table          # (loads Numba)
+    return edge_table(np.ascontiguousarray(faces, dtype=np.int64).reshape(-1, 3))
 
 
 def split_nonmanifold(points: np.ndarray, faces: np.ndarray
@@ -59,6 +49,7 @@ def split_nonmanifold(points: np.ndarray, faces: np.ndarray
     """``(points, faces, left)``: the mesh with its non-manifold vertices split
     (module docstring); ``left`` counts the edges still in more than two
     triangles."""
+    from .manifold_kernels import by_edge, corner_groups          # (loads Numba)
     nf = len(faces)
     if nf == 0:
         return points, faces, 0
@@ -67,17 +58,14 @@ def split_nonmanifold(points: np.ndarray, faces: np.ndarray
     k = np.arange(3 * nf) % 3
     start, end = faces[tri, k], faces[tri, (k + 1) % 3]
     # partner incidence of every incidence on a manifold edge (the other triangle)
-    order = np.argsort(inc, kind="stable")
-    first = np.concatenate([[0], np.cumsum(counts)[:-1]])
-    two = counts[inc[order]] == 2
-    pairs = []
-    sel = order[two].reshape(-1, 2)
-    pairs.append(sel)
+    order, first = by_edge(inc, counts)
+    two = np.flatnonzero(counts == 2)
+    pairs = [np.stack([order[first[two]], order[first[two] + 1]], 1)]
     many = np.flatnonzero(counts > 2)
     if len(many):
         pairs.append(_pair_around(points, faces, edges, inc, order, first, counts, many,
                                   start, end, tri, k))
-    pair = np.concatenate(pairs) if pairs else np.zeros((0, 2), dtype=np.int64)
+    pair = np.concatenate(pairs)
     # join corners: incidence i runs start->end in triangle tri; its partner j runs
     # end->start; corner (tri_i, start_i) ~ (tri_j, end_j), (tri_i, end_i) ~ (tri_j, start_j)
     i, j = pair[:, 0], pair[:, 1]
@@ -86,12 +74,11 @@ def split_nonmanifold(points: np.ndarray, faces: np.ndarray
     a = np.concatenate([corner_start[i], corner_end[i]])
     b = np.concatenate([np.where(start[j] == start[i], corner_start[j], corner_end[j]),
                         np.where(end[j] == end[i], corner_end[j], corner_start[j])])
-    graph = sparse.coo_matrix((np.ones(len(a)), (a, b)), shape=(3 * nf, 3 * nf))
-    _, label = csgraph.connected_components(graph, directed=False)
-    vertex_of_corner = faces.ravel()
-    new, first_corner, new_faces = np.unique(label, return_index=True, return_inverse=True)
-    out_points = points[vertex_of_corner[first_corner]]
-    out_faces = new_faces.reshape(-1, 3)
+    label = corner_groups(3 * nf, a, b)
+    # each group of corners a vertex, numbered as its first corner comes
+    first_corner = np.flatnonzero(np.diff(np.maximum.accumulate(label), prepend=-1) > 0)
+    out_points = points[faces.ravel()[first_corner]]
+    out_faces = label.reshape(-1, 3)
     _, _, after = edge_counts(out_faces)
     return out_points, out_faces, int((after > 2).sum())
 

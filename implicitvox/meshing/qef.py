@@ -6,7 +6,8 @@ any point of the plane, at a sharp edge a point of the edge, at a corner the
 corner. The normal equations ``A v = b`` (``A = Σ n_i n_iᵀ``,
 ``b = Σ n_i n_iᵀ p_i``) are solved about the mass point ``m`` (the mean of the
 ``p_i``) with the eigenvalues of ``A`` below ``TRUNCATE`` times the largest
-set to zero (the pseudo-inverse Ju et al. and Lindstrom use), so the free
+set to zero (the pseudo-inverse Ju et al. and Lindstrom use; compiled,
+:mod:`.qef_kernels`), so the free
 directions of a flat or edge-like patch stay at ``m``. A vertex outside its
 cell is clamped into it: the Hausdorff bound of
 :mod:`implicitvox.meshing.adaptive` needs each vertex in its cell.
@@ -36,22 +37,9 @@ def solve(cell: np.ndarray, points: np.ndarray, normals: np.ndarray, n_cells: in
 
     ``cell[i]`` is the cell of crossing ``i``; ``lo, hi`` ``(n_cells, 3)`` the
     cells' boxes. A cell without crossings gets its box centre."""
-    count = np.bincount(cell, minlength=n_cells).astype(np.float64)
-    mass = np.stack([np.bincount(cell, points[:, a], n_cells) for a in range(3)], 1)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        mass = np.where(count[:, None] > 0, mass / count[:, None], 0.5 * (lo + hi))
-    rel = points - mass[cell]                  # about the mass point: well conditioned
-    A = np.zeros((n_cells, 3, 3))
-    rhs = np.zeros((n_cells, 3))
-    d = np.einsum("ij,ij->i", normals, rel)
-    for r in range(3):
-        rhs[:, r] = np.bincount(cell, normals[:, r] * d, n_cells)
-        for c in range(r, 3):
-            A[:, r, c] = A[:, c, r] = np.bincount(cell, normals[:, r] * normals[:, c], n_cells)
-    w, V = np.linalg.eigh(A)                   # ascending eigenvalues
-    keep = w > TRUNCATE * np.maximum(w[:, -1:], 1e-300)
-    inv = np.where(keep, 1.0 / np.where(keep, w, 1.0), 0.0)
-    coef = np.einsum("nji,nj->ni", V, rhs) * inv
-    vertex = mass + np.einsum("nij,nj->ni", V, coef)
-    vertex = np.where(np.isfinite(vertex), vertex, mass)
-    return np.clip(vertex, lo, hi)
+    from .qef_kernels import qef_vertices, quadric_sums          # (loads Numba)
+    count, mass, A, rhs = quadric_sums(np.asarray(cell, dtype=np.int64),
+                                       np.ascontiguousarray(points, dtype=np.float64),
+                                       np.ascontiguousarray(normals, dtype=np.float64), n_cells)
+    return qef_vertices(count, mass, A, rhs, np.ascontiguousarray(lo, dtype=np.float64),
+                        np.ascontiguousarray(hi, dtype=np.float64), TRUNCATE)
