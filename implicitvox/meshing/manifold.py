@@ -49,34 +49,29 @@ def split_nonmanifold(points: np.ndarray, faces: np.ndarray
     """``(points, faces, left)``: the mesh with its non-manifold vertices split
     (module docstring); ``left`` counts the edges still in more than two
     triangles."""
-    from .manifold_kernels import by_edge, corner_groups          # (loads Numba)
+    from .manifold_kernels import by_edge, corner_groups, corner_joins   # (loads Numba)
     nf = len(faces)
     if nf == 0:
         return points, faces, 0
+    faces = np.ascontiguousarray(faces, dtype=np.int64)
     edges, inc, counts = edge_counts(faces)
-    tri = np.arange(3 * nf) // 3
-    k = np.arange(3 * nf) % 3
-    start, end = faces[tri, k], faces[tri, (k + 1) % 3]
     # partner incidence of every incidence on a manifold edge (the other triangle)
     order, first = by_edge(inc, counts)
     two = np.flatnonzero(counts == 2)
     pairs = [np.stack([order[first[two]], order[first[two] + 1]], 1)]
     many = np.flatnonzero(counts > 2)
     if len(many):
+        tri = np.arange(3 * nf) // 3
+        k = np.arange(3 * nf) % 3
+        start, end = faces[tri, k], faces[tri, (k + 1) % 3]
         pairs.append(_pair_around(points, faces, edges, inc, order, first, counts, many,
                                   start, end, tri, k))
     pair = np.concatenate(pairs)
     # join corners: incidence i runs start->end in triangle tri; its partner j runs
     # end->start; corner (tri_i, start_i) ~ (tri_j, end_j), (tri_i, end_i) ~ (tri_j, start_j)
-    i, j = pair[:, 0], pair[:, 1]
-    corner_start = 3 * tri + k                    # the corner at the incidence's start
-    corner_end = 3 * tri + (k + 1) % 3
-    a = np.concatenate([corner_start[i], corner_end[i]])
-    b = np.concatenate([np.where(start[j] == start[i], corner_start[j], corner_end[j]),
-                        np.where(end[j] == end[i], corner_end[j], corner_start[j])])
-    label = corner_groups(3 * nf, a, b)
+    a, b = corner_joins(faces, np.ascontiguousarray(pair[:, 0]), np.ascontiguousarray(pair[:, 1]))
+    label, first_corner = corner_groups(3 * nf, a, b)
     # each group of corners a vertex, numbered as its first corner comes
-    first_corner = np.flatnonzero(np.diff(np.maximum.accumulate(label), prepend=-1) > 0)
     out_points = points[faces.ravel()[first_corner]]
     out_faces = label.reshape(-1, 3)
     _, _, after = edge_counts(out_faces)

@@ -99,10 +99,12 @@ def test_edge_table_and_corner_groups_are_numpys_and_scipys():
     keys, expect = np.unique(ends, axis=0, return_counts=True)
     assert len(edges) == len(keys)
     assert np.array_equal(counts[np.lexsort(edges.T[::-1])], expect)
+    assert (np.diff(edges[:, 0]) >= 0).all()                  # by their lower end
     order, first = by_edge(inc, counts)
     assert np.array_equal(order, np.argsort(inc, kind="stable"))
     a, b = rng.integers(0, 500, size=(2, 300))
-    labels = corner_groups(500, a, b)
+    labels, first_corner = corner_groups(500, a, b)
     _, expect = connected_components(coo_matrix((np.ones(300), (a, b)), shape=(500, 500)),
                                      directed=False)
     assert np.array_equal(labels, expect)
+    assert np.array_equal(first_corner, np.unique(expect, return_index=True)[1])
