@@ -53,8 +53,9 @@ from .tape import Tape
 from .tape_pool import (ARG_A, ARG_B, ARG_C, OP, OUT, OUTPUT, ROW, ROWS, START, VALUE,
                         TapePool)
 
-__all__ = ["pool_gradients", "takes_pool", "tape_arrays", "tape_gradients", "crossing_points",
-           "TapeArrays", "POINT_OPS", "numpy_minimum", "numpy_maximum"]
+__all__ = ["pool_gradients", "pool_values", "pool_crossings", "takes_pool", "tape_arrays",
+           "tape_gradients", "crossing_points", "TapeArrays", "POINT_OPS", "numpy_minimum",
+           "numpy_maximum"]
 
 #: the operations :func:`pool_gradients` runs (numbers of :data:`implicitvox.eval.compiled.OPS`)
 POINT_OPS = frozenset((ADD, SUB, MUL, DIV, NEG, SQUARE, SQRT, ABS, MIN, MAX, ADDC, RSUBC, MULC,
@@ -77,20 +78,71 @@ def pool_gradients(pool: TapePool, tapes: np.ndarray, counts: np.ndarray, xs: np
     if not takes_pool(pool):
         return None
     n = len(xs)
-    if int(np.sum(counts)) != n:
-        raise ValueError(f"the runs cover {int(np.sum(counts))} points, not {n}")
+    _runs_cover(counts, n)
     values, grads = np.empty(n), np.empty((3, n))
     if pool.undefined:
         values[:], grads[:] = np.nan, np.nan
         return values, grads
-    registers = int(pool.tapes[:len(pool), 4].max()) if len(pool) else 0
+    registers = _registers(pool)
     _run(pool.rows, pool.tapes, pool.params, pool.is_constant, pool.constant_value,
          pool.inputs, np.ascontiguousarray(tapes, dtype=np.int64),
          np.ascontiguousarray(counts, dtype=np.int64),
          np.ascontiguousarray(xs, dtype=np.float64), np.ascontiguousarray(ys, dtype=np.float64),
          np.ascontiguousarray(zs, dtype=np.float64), values, grads,
-         np.empty(max(registers, pool.fixed, 1)), np.empty((3, max(registers, pool.fixed, 1))))
+         np.empty(registers), np.empty((3, registers)))
     return values, grads
+
+
+def _registers(pool: TapePool) -> int:
+    """Registers a pool tape may use (the fixed ones included)."""
+    used = int(pool.tapes[:len(pool), 4].max()) if len(pool) else 0
+    return max(used, pool.fixed, 1)
+
+
+def _runs_cover(counts: np.ndarray, n: int) -> None:
+    if int(np.sum(counts)) != n:
+        raise ValueError(f"the runs cover {int(np.sum(counts))} points, not {n}")
+
+
+def pool_values(pool: TapePool, tapes: np.ndarray, counts: np.ndarray, xs: np.ndarray,
+                ys: np.ndarray, zs: np.ndarray) -> Optional[np.ndarray]:
+    """The values of :func:`pool_gradients` alone (the same floats, without the
+    derivatives), or None (:func:`takes_pool`)."""
+    if not takes_pool(pool):
+        return None
+    _runs_cover(counts, len(xs))
+    values = np.empty(len(xs))
+    if pool.undefined:
+        values[:] = np.nan
+        return values
+    registers = _registers(pool)
+    _run_values(pool.rows, pool.tapes, pool.params, pool.is_constant, pool.constant_value,
+                pool.inputs, np.ascontiguousarray(tapes, dtype=np.int64),
+                np.ascontiguousarray(counts, dtype=np.int64),
+                np.ascontiguousarray(xs, dtype=np.float64),
+                np.ascontiguousarray(ys, dtype=np.float64),
+                np.ascontiguousarray(zs, dtype=np.float64), values, np.empty(registers),
+                np.empty((3, registers)))
+    return values
+
+
+def pool_crossings(pool: TapePool, tapes: np.ndarray, counts: np.ndarray, a: np.ndarray,
+                   b: np.ndarray, steps: int) -> Optional[np.ndarray]:
+    """:func:`crossing_points` on edges ``a -> b`` (n, 3) in runs of pool tapes (the
+    first ``counts[0]`` edges on ``tapes[0]``, ...): the same points as on each
+    tape built alone, or None (:func:`takes_pool`, or an undefined pool)."""
+    if not takes_pool(pool) or pool.undefined:
+        return None
+    _runs_cover(counts, len(a))
+    a = np.ascontiguousarray(a, dtype=np.float64)
+    points = np.empty_like(a)
+    registers = _registers(pool)
+    _bisect_runs(pool.rows, pool.tapes, pool.params, pool.is_constant, pool.constant_value,
+                 pool.inputs, np.ascontiguousarray(tapes, dtype=np.int64),
+                 np.ascontiguousarray(counts, dtype=np.int64), a,
+                 np.ascontiguousarray(b, dtype=np.float64), int(steps), points,
+                 np.empty(registers), np.empty((3, registers)))
+    return points
 
 
 @dataclass(frozen=True)
@@ -181,7 +233,7 @@ def crossing_points(tape: Tape, a: np.ndarray, b: np.ndarray, steps: int
     a = np.ascontiguousarray(a, dtype=np.float64)
     points = np.empty_like(a)
     registers = is_constant.size
-    _bisect(rows, n, output, params, is_constant, constant_value, inputs, a,
+    _bisect(rows, 0, n, output, params, is_constant, constant_value, inputs, a,
             np.ascontiguousarray(b, dtype=np.float64), int(steps), points,
             np.empty(registers), np.empty((3, registers)))
     return points
@@ -332,20 +384,46 @@ def _run(rows, tapes_, params, is_constant, constant_value, inputs, tapes, count
 
 
 @njit(**COMPILE)
-def _bisect(rows, length, output, params, is_constant, constant_value, inputs, a, b, steps,
-            points, val, grad):
+def _run_values(rows, tapes_, params, is_constant, constant_value, inputs, tapes, counts, xs,
+                ys, zs, values, val, grad):
+    start = 0
+    for r in range(tapes.size):
+        t = tapes[r]
+        first, length, output = tapes_[t, START], tapes_[t, ROWS], tapes_[t, OUTPUT]
+        for i in range(start, start + counts[r]):
+            values[i] = _at_point(rows, first, length, output, params, is_constant,
+                                  constant_value, inputs, xs[i], ys[i], zs[i], val, grad, 0)
+        start += counts[r]
+
+
+@njit(**COMPILE)
+def _bisect_runs(rows, tapes_, params, is_constant, constant_value, inputs, tapes, counts, a, b,
+                 steps, points, val, grad):
+    start = 0
+    for r in range(tapes.size):
+        t = tapes[r]
+        end = start + counts[r]
+        _bisect(rows, tapes_[t, START], tapes_[t, ROWS], tapes_[t, OUTPUT], params,
+                is_constant, constant_value, inputs, a[start:end], b[start:end], steps,
+                points[start:end], val, grad)
+        start = end
+
+
+@njit(**COMPILE)
+def _bisect(rows, first, length, output, params, is_constant, constant_value, inputs, a, b,
+            steps, points, val, grad):
     """:func:`implicitvox.meshing.edges.crossings`' bisection, edge by edge: the
     bracket of the sign change on ``a[i] -> b[i]`` halved ``steps`` times, its
     midpoint into ``points[i]`` (the same arithmetic, step for step)."""
     for i in range(a.shape[0]):
         d0, d1, d2 = b[i, 0] - a[i, 0], b[i, 1] - a[i, 1], b[i, 2] - a[i, 2]
-        inside_a = _at_point(rows, 0, length, output, params, is_constant, constant_value,
+        inside_a = _at_point(rows, first, length, output, params, is_constant, constant_value,
                              inputs, a[i, 0], a[i, 1], a[i, 2], val, grad, 0) < 0
         lo, hi = 0.0, 1.0
         for _ in range(steps):
             mid = 0.5 * (lo + hi)
-            inside = _at_point(rows, 0, length, output, params, is_constant, constant_value,
-                               inputs, a[i, 0] + mid * d0, a[i, 1] + mid * d1,
+            inside = _at_point(rows, first, length, output, params, is_constant,
+                               constant_value, inputs, a[i, 0] + mid * d0, a[i, 1] + mid * d1,
                                a[i, 2] + mid * d2, val, grad, 0) < 0
             if inside == inside_a:
                 lo = mid

@@ -57,10 +57,6 @@ import numpy as np
 
 from ..eval.function import Function
 from ..interval import rounding
-from ..eval.interval import evaluate_intervals
-from ..eval.mean_value import evaluate_interval_gradients
-from ..eval.point import evaluate_points
-from ..eval.tape import Tape
 from ..octree.grid import Grid
 from ..octree.guard import MemoryGuard
 from ..octree import morton
@@ -68,8 +64,9 @@ from ..octree.morton import CORNERS, NEIGHBOURS
 from ..octree.octants import run_counts
 from ..octree.subdivide import Subdivision, classify, subdivide
 from ..expr.shape import AMBIGUOUS
+from .cell_tapes import CellTapes
 
-__all__ = ["AdaptiveGrid", "adaptive_grid", "corner_values", "per_tape", "BYTES_PER_CELL",
+__all__ = ["AdaptiveGrid", "adaptive_grid", "corner_values", "BYTES_PER_CELL",
            "LEAF_LEVELS_UP"]
 
 #: bytes per leaf cell at the peak (measured: 1.9 kB on sin(9θ)sin(18φ) - r at 256):
@@ -79,10 +76,11 @@ BYTES_PER_CELL = 2048
 #: cells classified per numpy call below the tolerance level
 _CHUNK = 1 << 14
 #: the cells take the pruned tape of their ancestor this many levels above the
-#: tolerance level's voxels (valid over them all): the grid is built per tape, and a
-#: tape per voxel or two made the per-tape calls cost more than the shorter tapes saved
-#: (the level-3 sponge at 128: 24.5 s at 0, 21.8 at 2, 11.9 at 3, 13.3 at 4, 14.1 at 5)
-LEAF_LEVELS_UP = 3
+#: tolerance level's voxels (valid over them all). With a Python call per tape, a tape
+#: per voxel or two cost more than the shorter tapes saved (the level-3 sponge at 128:
+#: 24.5 s at 0, 11.9 at 3); on the pool's rows (:mod:`.cell_tapes`) 1 is best (3.0-3.1 s
+#: at 1, 3.45-3.55 s at 3, alternately; the same mesh)
+LEAF_LEVELS_UP = 1
 #: a gradient component counts as one-signed when its other side is within this
 #: share of the largest component (an exact 0 rounded outward)
 _FLAT = 1e-9
@@ -122,8 +120,8 @@ class AdaptiveGrid:
         (:func:`implicitvox.meshing.contour.dual_contour` checks).
     cells_evaluated : int
         Cells classified below the tolerance level.
-    tapes : list of Tape
-        The pruned tapes of the voxelization (one per run of its voxels).
+    tapes : CellTapes
+        The pruned tapes of the voxelization (each of its pool's tapes once).
     tape_index : ndarray of int64, (n,)
         The tape valid over each leaf (that of the voxel holding it).
     """
@@ -136,7 +134,7 @@ class AdaptiveGrid:
     simple: np.ndarray
     complex: np.ndarray
     cells_evaluated: int
-    tapes: list
+    tapes: CellTapes
     tape_index: np.ndarray
 
     @property
@@ -151,15 +149,17 @@ class AdaptiveGrid:
         return h * np.exp2(self.grid.depth - self.levels.astype(np.float64))
 
 
-def corner_values(func: Any, grid: Grid, level: int, coords: np.ndarray) -> np.ndarray:
+def corner_values(tapes: CellTapes, tid: np.ndarray, grid: Grid, level: int,
+                  coords: np.ndarray) -> np.ndarray:
     """``f`` (float64) at the 8 corners of cells ``coords`` at ``level`` of
-    ``grid``; each lattice point's position comes from :meth:`Grid.edge`, so
-    every cell sharing a corner sees the same value. ``func``: a
-    :class:`Function` or a tape valid over the cells."""
-    pos = corner_positions(grid, level, coords)
-    with np.errstate(all="ignore"):
-        values = evaluate_points(_tape(func), *pos)
-    return np.broadcast_to(values, (len(coords) * 8,)).reshape(-1, 8).astype(np.float64)
+    ``grid``, each cell on tape ``tid[i]`` of ``tapes`` (valid over it); each lattice
+    point's position comes from :meth:`Grid.edge`, so every cell sharing a corner
+    sees the same value."""
+    out = np.empty((len(coords), 8))
+    for s in range(0, len(coords), _CHUNK):
+        pos = corner_positions(grid, level, coords[s:s + _CHUNK])
+        out[s:s + _CHUNK] = tapes.values(np.repeat(tid[s:s + _CHUNK], 8), *pos).reshape(-1, 8)
+    return out
 
 
 def corner_positions(grid: Grid, level: int, coords: np.ndarray) -> tuple[np.ndarray, ...]:
@@ -170,7 +170,7 @@ def corner_positions(grid: Grid, level: int, coords: np.ndarray) -> tuple[np.nda
     return tuple(grid.edge(a, np.minimum(idx[..., a], grid.shape[a])).ravel() for a in range(3))
 
 
-def _monotone(func: Any, grid: Grid, level: int, coords: np.ndarray
+def _monotone(tapes: CellTapes, tid: np.ndarray, grid: Grid, level: int, coords: np.ndarray
               ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """``(weak, strict, leak)`` from the interval gradient over each cell.
 
@@ -185,8 +185,8 @@ def _monotone(func: Any, grid: Grid, level: int, coords: np.ndarray
     ``min(corners) - leak <= f <= max(corners) + leak`` over the cell;
     infinite where the mean value theorem may fail (domain edges, jumps)."""
     lo, hi = grid.octant_boxes(level, coords)
+    _, _, glo, ghi, valid = tapes.interval_gradients(tid, lo, hi)
     with np.errstate(all="ignore"):
-        _, _, glo, ghi, valid = evaluate_interval_gradients(_tape(func), lo, hi)
         glo, ghi = np.asarray(glo, dtype=np.float64), np.asarray(ghi, dtype=np.float64)
         valid = np.asarray(valid) & np.isfinite(glo).all(0) & np.isfinite(ghi).all(0)
         one_sided = np.minimum(np.maximum(ghi, 0.0), np.maximum(-glo, 0.0))       # (3, n)
@@ -201,49 +201,15 @@ def _monotone(func: Any, grid: Grid, level: int, coords: np.ndarray
     return weak, strict, leak
 
 
-def _corners_exclude(func: Any, grid: Grid, level: int, coords: np.ndarray,
-                     leak: np.ndarray) -> np.ndarray:
+def _corners_exclude(tapes: CellTapes, tid: np.ndarray, grid: Grid, level: int,
+                     coords: np.ndarray, leak: np.ndarray) -> np.ndarray:
     """True where the outward-rounded enclosures of ``f`` at all 8 corners lie
     beyond ``leak`` on one side of 0: then ``f`` has that sign on the whole cell."""
     pos = corner_positions(grid, level, coords)
+    flo, fhi = tapes.intervals(np.repeat(tid, 8), pos, pos)
     with np.errstate(all="ignore"):
-        flo, fhi = evaluate_intervals(_tape(func), pos, pos)
         flo, fhi = flo.reshape(-1, 8), fhi.reshape(-1, 8)
         return (rounding.down(flo.min(1) - leak) > 0) | (rounding.up(fhi.max(1) + leak) < 0)
-
-
-def _tape(func: Any) -> Tape:
-    """The tape of a :class:`Function`, or the tape itself."""
-    return func.tape if isinstance(func, Function) else func
-
-
-def per_tape(tapes: list, tid: np.ndarray, fn: Callable, *arrays: np.ndarray,
-             chunk: int = _CHUNK) -> tuple:
-    """``fn(tape, *rows)`` over the rows of each tape (``tapes[tid[i]]`` is valid
-    over row ``i``), in chunks of ``chunk`` rows; the outputs (a tuple of arrays,
-    rows first) put back in row order. The pruned tapes of the voxelization
-    (:attr:`implicitvox.octree.subdivide.Subdivision.tapes`) give the same
-    values, enclosures and gradients as the whole tape over their octants, in
-    fewer operations (:mod:`implicitvox.eval.pruning`)."""
-    n = len(tid)
-    order = np.argsort(tid, kind="stable")
-    starts = np.searchsorted(tid[order], np.arange(len(tapes) + 1))
-    outs: Optional[list] = None
-    for t in range(len(tapes)):
-        group = order[starts[t]:starts[t + 1]]
-        for s in range(0, len(group), chunk):
-            rows = group[s:s + chunk]
-            got = fn(tapes[t], *(a[rows] for a in arrays))
-            got = got if isinstance(got, tuple) else (got,)
-            if outs is None:
-                outs = [np.empty((n,) + np.shape(g)[1:], dtype=np.asarray(g).dtype) for g in got]
-            for o, g in zip(outs, got):
-                o[rows] = g
-    if outs is None:
-        got = fn(tapes[0], *(a[:0] for a in arrays))
-        got = got if isinstance(got, tuple) else (got,)
-        outs = [np.asarray(g) for g in got]
-    return tuple(outs)
 
 
 def _children(grid: Grid, level: int, coords: np.ndarray, owner: Optional[np.ndarray] = None
@@ -275,11 +241,11 @@ def _touch_only(exact: Optional[Callable], grid: Grid, level: int, cells: np.nda
 
 
 def _search(func: Function, grid: Grid, level: int, cells: np.ndarray,
-            exact: Optional[Callable], levels: int, tapes: list, tid: np.ndarray
+            exact: Optional[Callable], levels: int, tapes: CellTapes, tid: np.ndarray
             ) -> tuple[np.ndarray, np.ndarray]:
     """For cells without a sign change that no certificate empties: search their
     subtrees ``levels`` levels down (at most to ``grid.depth``), each with its
-    cell's tape (``tapes[tid[i]]``).
+    cell's tape (tape ``tid[i]`` of ``tapes``).
 
     Returns ``(shows, empty)``: a descendant shows a sign change (surface the
     corners miss: a thin sheet, a bump through a face; the cell is split), or
@@ -300,17 +266,14 @@ def _search(func: Function, grid: Grid, level: int, cells: np.ndarray,
         current, owner = current[states == AMBIGUOUS], owner[states == AMBIGUOUS]
         if not len(current):
             break
-        at = level
-        inside = per_tape(tapes, tid[owner], lambda t, c: corner_values(t, grid, at, c),
-                          current)[0] < 0
+        inside = corner_values(tapes, tid[owner], grid, level, current) < 0
         change = inside.any(1) & ~inside.all(1)
         shows[owner[change]] = True
         rest = ~change & ~shows[owner]
         if rest.any():
             sub, sub_tid = current[rest], tid[owner[rest]]
-            _, _, leak = per_tape(tapes, sub_tid, lambda t, c: _monotone(t, grid, at, c), sub)
-            keep = ~per_tape(tapes, sub_tid,
-                             lambda t, c, w: _corners_exclude(t, grid, at, c, w), sub, leak)[0]
+            _, _, leak = _monotone(tapes, sub_tid, grid, level, sub)
+            keep = ~_corners_exclude(tapes, sub_tid, grid, level, sub, leak)
             keep[keep] = ~_touch_only(exact, grid, level, sub[keep])
             rest[rest] = keep
         current, owner = current[rest], owner[rest]
@@ -384,9 +347,9 @@ def adaptive_grid(func: Function, grid: Grid, refine: int, *,
         voxels = subdivide(func, grid, exact=exact, exact_voxels=exact_voxels, guard=guard,
                            prune=prune, progress=(lambda s: share(0.6 * s)),
                            leaf_level=max(top - LEAF_LEVELS_UP, 0))
-    tapes = [t for _, t in voxels.tapes] or [func.tape]
-    tid = np.repeat(np.arange(len(voxels.tapes)), run_counts(voxels.tapes)) \
-        if voxels.tapes else np.zeros(len(voxels.codes), dtype=np.int64)
+    tapes, of_run = CellTapes.of_runs(voxels.tapes, func.tape)
+    tid = np.repeat(of_run, run_counts(voxels.tapes)) \
+        if len(voxels.tapes) else np.zeros(len(voxels.codes), dtype=np.int64)
     order = np.argsort(voxels.codes, kind="stable")
     cells = morton.decode(voxels.codes[order]).astype(np.int64)
     tid = tid[order]
@@ -403,18 +366,16 @@ def adaptive_grid(func: Function, grid: Grid, refine: int, *,
             cells, tid = cells[states == AMBIGUOUS], tid[states == AMBIGUOUS]
         if not len(cells):
             break
-        at = level
-        values = per_tape(tapes, tid, lambda t, c: corner_values(t, fine, at, c), cells)[0]
+        values = corner_values(tapes, tid, fine, level, cells)
         inside = values < 0
         change = inside.any(1) & ~inside.all(1)
-        weak, strict, leak = per_tape(tapes, tid, lambda t, c: _monotone(t, fine, at, c), cells)
+        weak, strict, leak = _monotone(tapes, tid, fine, level, cells)
         simple = change & (weak | strict)
         empty = np.zeros(len(cells), dtype=bool)
         test = ~change & np.isfinite(leak)
         if test.any():
-            empty[test] = per_tape(tapes, tid[test],
-                                   lambda t, c, w: _corners_exclude(t, fine, at, c, w),
-                                   cells[test], leak[test])[0]
+            empty[test] = _corners_exclude(tapes, tid[test], fine, level, cells[test],
+                                           leak[test])
         test = ~change & ~empty
         if test.any():
             empty[test] = _touch_only(exact, fine, level, cells[test])

@@ -37,8 +37,7 @@ import numpy as np
 from ..eval.function import Function
 from ..octree import morton
 from ..octree.morton import CORNERS, NEIGHBOURS
-from .adaptive import AdaptiveGrid, per_tape
-from .edges import crossings
+from .adaptive import AdaptiveGrid
 from .qef import solve
 
 __all__ = ["Contour", "dual_contour"]
@@ -126,8 +125,7 @@ def dual_contour(func: Function, agrid: AdaptiveGrid, bound: float = np.inf,
     e_end[np.arange(len(first)), e_axis] += e_length
     a_pos = np.stack([grid.edge(k, e_start[:, k]) for k in range(3)], 1)
     b_pos = np.stack([grid.edge(k, e_end[:, k]) for k in range(3)], 1)
-    p, nrm = per_tape(agrid.tapes, agrid.tape_index[leaf[first]],
-                      lambda tape, a, b: crossings(tape, a, b), a_pos, b_pos)
+    p, nrm = agrid.tapes.crossings(agrid.tape_index[leaf[first]], a_pos, b_pos)
     scale = np.left_shift(1, depth - agrid.levels.astype(np.int64))       # cell size, fine units
     lo = np.stack([grid.edge(k, agrid.coords[:, k] * scale) for k in range(3)], 1)
     hi = np.stack([grid.edge(k, np.minimum((agrid.coords[:, k] + 1) * scale, grid.shape[k]))

@@ -30,7 +30,7 @@ from ..eval.function import Function
 from ..eval.gradient import evaluate_gradients
 from ..eval.point import evaluate_points
 
-__all__ = ["crossings", "STEPS"]
+__all__ = ["crossings", "unit_normals", "STEPS"]
 
 #: bisection steps: the bracket is 2**-STEPS of the edge
 STEPS = 16
@@ -54,7 +54,7 @@ def crossings(func: Any, a: np.ndarray, b: np.ndarray, steps: int = STEPS
     if compiled is not None:             # the same points and gradients, in compiled code
         points = compiled
         _, g = tape_gradients(tape, *points.T)
-        return points, _unit(g)
+        return points, unit_normals(g)
     with np.errstate(all="ignore"):
         inside_a = np.broadcast_to(evaluate_points(tape, *a.T), (n,)) < 0
         lo = np.zeros(n)
@@ -69,10 +69,10 @@ def crossings(func: Any, a: np.ndarray, b: np.ndarray, steps: int = STEPS
             hi = np.where(same, hi, mid)
         points = a + (0.5 * (lo + hi))[:, None] * d
         _, g = evaluate_gradients(tape, *points.T)
-    return points, _unit(g)
+    return points, unit_normals(g)
 
 
-def _unit(g: np.ndarray) -> np.ndarray:
+def unit_normals(g: np.ndarray) -> np.ndarray:
     """Gradients ``(3, n)`` (or broadcastable) as unit rows ``(n, 3)``; zero where
     the gradient is zero or not finite."""
     n = np.asarray(g).reshape(3, -1).shape[1]

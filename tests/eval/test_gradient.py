@@ -109,3 +109,54 @@ def test_pool_gradients_are_the_array_evaluators_bit_for_bit(monkeypatch):
     from implicitvox.eval.tape import build_tape
     wavy = TapePool(build_tape(ivx.min(ivx.sin(x) - y, z)))
     assert pool_gradients(wavy, np.array([0]), np.array([1]), *np.zeros((3, 1))) is None
+
+
+def test_pool_values_enclosures_and_crossings_are_each_tapes_bit_for_bit(monkeypatch):
+    """The mesher's calls on a pool's rows (values at points, value and gradient
+    enclosures over boxes, crossings on edges, each row on its own pruned tape) equal
+    the array evaluators' (and the bisection's) on each tape built alone, bit for bit;
+    the enclosures also equal the plain interval evaluator's on point boxes."""
+    from implicitvox.eval.function import Function
+    from implicitvox.eval.interval import evaluate_intervals
+    from implicitvox.eval.mean_value import array_interval_gradients
+    from implicitvox.eval.mean_value_kernels import pool_interval_gradients
+    from implicitvox.eval.point import evaluate_points
+    from implicitvox.eval.pool_gradients import pool_crossings, pool_values
+    from implicitvox.expr.shape import as_shape
+    from implicitvox.meshing.edges import STEPS, crossings
+    from implicitvox.octree import descend
+    from implicitvox.octree.grid import Grid
+    monkeypatch.setattr(descend, "DERIVE_COST", 0)
+    rng = np.random.default_rng(6)
+    for name, model in _csg_models().items():
+        shape = as_shape(model)
+        runs = descend.descend(Function(shape.expr), Grid.from_bounds(shape.bounds, 24)).tapes
+        counts = rng.integers(1, 30, len(runs))
+        n = int(counts.sum())
+        pts = rng.uniform(-1.2, 1.2, (3, n))
+        pts[:, :8] = 0.0                                   # ties of min, max and abs
+        lo = pts - rng.uniform(0, 0.1, (3, n)) * (rng.uniform(size=n) < 0.8)
+        hi = pts + rng.uniform(0, 0.1, (3, n))
+        a = pts.T.copy()
+        b = a + rng.uniform(-0.2, 0.2, (n, 3))
+        values = pool_values(runs.pool, runs.ids, counts, *pts)
+        enclosures = pool_interval_gradients(runs.pool, runs.ids, counts, lo, hi)
+        points = pool_crossings(runs.pool, runs.ids, counts, a, b, STEPS)
+        at_points = pool_interval_gradients(runs.pool, runs.ids, counts, pts, pts)
+        start = 0
+        for count, tape in zip(counts, (runs.tape(i) for i in range(len(runs)))):
+            rows = slice(start, start + count)
+            with np.errstate(all="ignore"):
+                v = np.broadcast_to(evaluate_points(tape, *pts[:, rows]), (count,))
+                want = array_interval_gradients(tape, tuple(lo[:, rows]), tuple(hi[:, rows]))
+                flo, fhi = evaluate_intervals(tape, tuple(pts[:, rows]), tuple(pts[:, rows]))
+            np.testing.assert_array_equal(values[rows], v, err_msg=name)
+            for got, expect in zip(enclosures, want):
+                np.testing.assert_array_equal(got[..., rows],
+                                              np.broadcast_to(expect, got[..., rows].shape),
+                                              err_msg=name)
+            np.testing.assert_array_equal(at_points[0][rows], flo, err_msg=name)
+            np.testing.assert_array_equal(at_points[1][rows], fhi, err_msg=name)
+            np.testing.assert_array_equal(points[rows], crossings(tape, a[rows], b[rows])[0],
+                                          err_msg=name)
+            start += count

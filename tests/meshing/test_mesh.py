@@ -275,6 +275,29 @@ def test_pruned_tapes_give_the_same_mesh_bit_for_bit(monkeypatch):
         digest(ivx.mesh(shape, resolution=64, prune=False))
 
 
+def test_cells_on_the_pools_rows_give_the_per_tape_mesh(monkeypatch):
+    """The adaptive grid and the crossings run every cell on the pool's rows in one
+    compiled call; building each pruned tape and evaluating it alone (the path of
+    tapes from worker processes) gives the same mesh, bit for bit."""
+    from implicitvox.expr.examples import menger
+    from implicitvox.meshing import adaptive
+    from implicitvox.meshing.cell_tapes import CellTapes
+    shape = menger(2)
+    fast = ivx.mesh(shape, resolution=40, workers=1)
+    grid = grid_of(shape.bounds, None, 40, None)
+    cells = adaptive.adaptive_grid(ivx.compile(shape.expr), grid, 1).tapes
+    assert cells.compiled and len(cells) > 20
+    by_runs = CellTapes.of_runs
+
+    def per_tape(runs, default):
+        tapes, tid = by_runs(runs, default)
+        return CellTapes(tapes.tapes), tid
+    monkeypatch.setattr(CellTapes, "of_runs", staticmethod(per_tape))
+    slow = ivx.mesh(shape, resolution=40, workers=1)
+    assert np.array_equal(fast.points, slow.points)
+    assert np.array_equal(fast.regular_faces, slow.regular_faces)
+
+
 def test_compiled_crossings_are_the_array_bisections(monkeypatch):
     """Crossings and normals on tapes the compiled evaluator runs (CSG: min, max, abs,
     distances, hypot) equal the array bisection's, bit for bit."""
