@@ -390,4 +390,12 @@ def rotation_mesh_outlines(pieces: list, angle: float, sectors: int
                  | np.all(tv[:, 0] == tv[:, 2], axis=1))
     f, tv = f[~collapsed], tv[~collapsed]
     volume = np.sum(np.einsum("ij,ij->i", tv[:, 0], np.cross(tv[:, 1], tv[:, 2])))
+    # the rings' copies of a point on the axis are one vertex: a closed manifold mesh
+    on_axis = np.flatnonzero((v[:, 0] == 0) & (v[:, 1] == 0))
+    if len(on_axis):
+        _, first = np.unique(v[on_axis, 2], return_inverse=True)
+        _, lead = np.unique(first, return_index=True)
+        renumber = np.arange(len(v))
+        renumber[on_axis] = on_axis[lead][first]
+        f = renumber[f]
     return v, (f if volume > 0 else f[:, ::-1])

@@ -58,6 +58,10 @@ SCENE_TYPES: dict[str, type] = {}
 _REGULARIZERS: list[Callable[["Solid"], Optional[Any]]] = []
 
 
+#: what builds a tree's :attr:`Solid.boundary_mesh` (:mod:`csg.tree_mesh` registers it)
+_BOUNDARIES: list[Callable[["Solid"], Optional[tuple]]] = []
+
+
 #: what gives a tree's facets (its leaves' triangles, moved) for its normals: the meshes
 #: live above the solids, :mod:`csg.tree_mesh` registers it on import
 _FACETS: list[Callable[["Solid"], Optional[np.ndarray]]] = []
@@ -67,6 +71,12 @@ def register_facets(build: Callable[["Solid"], Optional[np.ndarray]]) -> None:
     """Make ``build(solid)`` (its leaves' triangles ``(t, 3, 3)``, or None) what
     :attr:`Solid.surface_normals` falls back on."""
     _FACETS.append(build)
+
+
+def register_boundary(build: Callable[["Solid"], Optional[tuple]]) -> None:
+    """Make ``build(solid)`` (the closed mesh ``(vertices, faces)`` of the regularized
+    solid's boundary, or None) what :attr:`Solid.boundary_mesh` asks."""
+    _BOUNDARIES.append(build)
 
 
 def register_regularizer(build: Callable[["Solid"], Optional[Any]]) -> None:
@@ -281,6 +291,17 @@ class Solid:
         where they touch (a tie no halving settles) by :attr:`regularized_boundary`."""
         return exact_classifier(self.exact_plan, settle=True,
                                 regularized=lambda: self.regularized_boundary)
+
+    @functools.cached_property
+    def boundary_mesh(self) -> Optional[tuple[np.ndarray, np.ndarray]]:
+        """The closed triangle mesh ``(vertices (m, 3), faces (k, 3))``, oriented
+        outward, of the regularized solid's boundary where every leaf is a polytope
+        (OpenSCAD's facets, imported meshes, boxes, extrusions of outlines; the
+        booleans computed by Manifold: :func:`csg.tree_mesh.tree_mesh`), no faces
+        where it is empty; None where the tree has no such mesh (a curved leaf, an open
+        mesh). :func:`implicitvox.mesh` returns it for solids whose function only
+        bounds them. Built once."""
+        return None if _BOUNDARIES == [] else _BOUNDARIES[-1](self)
 
     @functools.cached_property
     def regularized_boundary(self) -> Optional[Any]:

@@ -31,12 +31,16 @@ import numpy as np
 from implicitvox.expr.shape import EMPTY
 from implicitvox.triangles.closed import mesh_volume
 
-from .protocol import NotAMesh, fold
+from .clipper2d import region_pieces
+from .facets import extrusion_mesh_outlines
+from .planar import LinearExtrude
+from .prism import Prism
+from .protocol import NotAMesh, NotFlat, fold
 from .tree_classifier import MeshClassifier
-from .solid import Solid, register_facets, register_regularizer
+from .solid import Solid, register_boundary, register_facets, register_regularizer
 
-__all__ = ["tree_mesh", "leaf_mesh", "mesh_volume", "NotAMesh", "regularized_classifier",
-           "EmptyBoundary"]
+__all__ = ["tree_mesh", "leaf_mesh", "mesh_volume", "NotAMesh", "boundary_mesh",
+           "regularized_classifier", "EmptyBoundary"]
 
 def leaf_mesh(solid: Solid, matrix: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """The closed triangle mesh (vertices, faces) of a polytope leaf, moved by
@@ -47,11 +51,26 @@ def leaf_mesh(solid: Solid, matrix: np.ndarray) -> tuple[np.ndarray, np.ndarray]
     NotAMesh
         A curved leaf (``curved`` set), or a kind of leaf with no mesh here.
     """
-    v, f = solid.closed_mesh()
+    v, f = _closed_mesh(solid)
     v = v @ matrix[:3, :3].T + matrix[:3, 3]
     if mesh_volume(v, f) < 0:                 # given inward (or mirrored by the matrix)
         f = f[:, ::-1]
     return v, f
+
+
+def _closed_mesh(solid: Solid) -> tuple[np.ndarray, np.ndarray]:
+    """A leaf's :meth:`~csg.solid.Solid.closed_mesh`; an extrusion of a polygonal
+    section scaled evenly, without twist (kept with its section's function in
+    ``facets="openscad"``), is OpenSCAD's one slice of it: its walls are planar."""
+    if isinstance(solid, LinearExtrude) and not isinstance(solid, Prism) and solid.twist == 0:
+        try:
+            pieces = region_pieces(solid.children[0])
+        except NotFlat as err:
+            raise NotAMesh(f"a linear_extrude of a curved section has no mesh ({err})",
+                           curved=True) from None
+        z0 = -solid.height / 2 if solid.centered else 0.0
+        return extrusion_mesh_outlines(pieces, solid.height, 0.0, solid.scale_top, 1, z0)
+    return solid.closed_mesh()
 
 
 _MANIFOLD_OPS = {"union": "Add", "difference": "Subtract", "intersection": "Intersect"}
@@ -97,7 +116,8 @@ def tree_mesh(solid: Solid, matrix: np.ndarray) -> tuple[np.ndarray, np.ndarray]
     if solid.operation not in ("transform", "union", "difference", "intersection"):
         return leaf_mesh(solid, matrix)
     result = _manifold(solid, matrix).to_mesh64()
-    v = np.asarray(result.vert_properties, dtype=np.float64)[:, :3]
+    v = np.array(np.asarray(result.vert_properties, dtype=np.float64)[:, :3])   # (a copy:
+    # a view would keep Manifold's mesh alive, and nanobind reports it as leaked at exit)
     return v, np.asarray(result.tri_verts, dtype=np.int64).reshape(-1, 3)
 
 
@@ -112,15 +132,24 @@ class EmptyBoundary:
         return np.full(len(lo), EMPTY, dtype=np.int8)
 
 
-def regularized_classifier(solid: Solid):
-    """The exact box test (:class:`~csg.tree_classifier.MeshClassifier`) of the boundary of
-    the regularized ``solid``: its :func:`tree_mesh`, whose booleans keep no face
-    shared inside the solid (:class:`EmptyBoundary` where the mesh is empty); None
-    where the tree has no mesh (a curved leaf, an open mesh)."""
+def boundary_mesh(solid: Solid) -> Optional[tuple[np.ndarray, np.ndarray]]:
+    """The regularized ``solid``'s boundary: its :func:`tree_mesh`, whose booleans keep
+    no face shared inside the solid; None where the tree has no mesh (a curved leaf,
+    an open mesh)."""
     try:
-        v, f = tree_mesh(solid, np.eye(4))
+        return tree_mesh(solid, np.eye(4))
     except (NotAMesh, ValueError):
         return None
+
+
+def regularized_classifier(solid: Solid):
+    """The exact box test (:class:`~csg.tree_classifier.MeshClassifier`) of the boundary of
+    the regularized ``solid`` (:attr:`~csg.solid.Solid.boundary_mesh`;
+    :class:`EmptyBoundary` where it is empty); None where the tree has no mesh."""
+    found = solid.boundary_mesh
+    if found is None:
+        return None
+    v, f = found
     return MeshClassifier(v, f) if len(f) else EmptyBoundary()
 
 
@@ -140,5 +169,6 @@ def leaf_triangles(solid: Solid) -> Optional[np.ndarray]:
     return np.concatenate(parts) if parts else None
 
 
+register_boundary(boundary_mesh)
 register_regularizer(regularized_classifier)
 register_facets(leaf_triangles)

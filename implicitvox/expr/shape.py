@@ -25,8 +25,12 @@ A shape has
 
 * ``expression_is_exact`` (optional, default True) - False when ``expr``
   only bounds the solid (zero inside a polyhedron's bounding box, say) and
-  the exact test alone knows the surface: such a shape can be voxelized,
-  not meshed (:func:`implicitvox.mesh` needs point values).
+  the exact test alone knows the surface: :func:`implicitvox.mesh` needs point
+  values, so it meshes such a shape by its ``boundary_mesh``;
+* ``boundary_mesh`` (optional) - None, or the closed triangle mesh
+  ``(vertices (m, 3), faces (k, 3))``, oriented outward, of the boundary of a
+  shape whose ``expr`` only bounds it (a polyhedral solid: :mod:`csg`'s OpenSCAD
+  facets and imported meshes, their booleans computed by Manifold);
 * ``surface_normals`` (optional) - None, or a function from points ``(n, 3)`` to
   unit normals ``(n, 3)`` of the surface near them, for a shape whose ``expr``
   only bounds it (its gradient says nothing of the surface: OpenSCAD's facets);
@@ -45,8 +49,8 @@ import numpy as np
 from .nodes import Expr
 
 __all__ = ["Shape", "EMPTY", "FULL", "AMBIGUOUS", "as_shape", "ExprShape", "exact_classifier",
-           "voxel_classifier", "expression_is_exact", "surface_normals", "Octants",
-           "takes_octants"]
+           "voxel_classifier", "expression_is_exact", "boundary_mesh", "surface_normals",
+           "Octants", "takes_octants"]
 
 #: octant states
 EMPTY, FULL, AMBIGUOUS = 0, 1, 2
@@ -140,3 +144,13 @@ def surface_normals(shape: Any) -> Optional[Callable[[np.ndarray], np.ndarray]]:
 def expression_is_exact(shape: Any) -> bool:
     """Whether the shape's ``expr`` is its own function (see the module docstring)."""
     return bool(getattr(shape, "expression_is_exact", True))
+
+
+def boundary_mesh(shape: Any) -> Optional[tuple[np.ndarray, np.ndarray]]:
+    """The shape's closed boundary mesh ``(vertices, faces)`` where it gives one (see
+    the module docstring), else None."""
+    found = getattr(shape, "boundary_mesh", None)
+    if found is None:
+        return None
+    vertices, faces = found
+    return np.asarray(vertices, dtype=np.float64), np.asarray(faces, dtype=np.int64)

@@ -25,7 +25,8 @@ import numpy as np
 
 from .. import validate
 from ..eval.function import Function
-from ..expr.shape import as_shape, exact_classifier, expression_is_exact, voxel_classifier
+from ..expr.shape import (as_shape, boundary_mesh, exact_classifier, expression_is_exact,
+                          voxel_classifier)
 from ..octree.grid import Grid, grid_of
 from ..octree.morton import MAX_BITS
 from ..octree.pilot import Estimate, estimate_surface
@@ -36,7 +37,7 @@ from ..octree.surface import SurfaceOptions
 from ..version import __version__
 from .adaptive import BYTES_PER_CELL, adaptive_grid
 from .contour import dual_contour
-from .manifold import split_nonmanifold
+from .manifold import edge_counts, split_nonmanifold
 
 __all__ = ["mesh", "mesh_grid", "estimate_meshing_memory", "REFINE"]
 
@@ -58,7 +59,12 @@ def mesh(shape: Any, tolerance: Optional[float] = None,
     ----------
     shape : Expr or Shape
         The implicit function ``f`` (solid ``f <= 0``) or a shape object (csg
-        solids and OpenSCAD models included: their exact box tests are used).
+        solids and OpenSCAD models included: their exact box tests are used). A
+        polyhedral solid (every part a polytope: boxes, OpenSCAD's facets, imported
+        meshes, extruded outlines) is meshed as its own closed boundary
+        (``shape.boundary_mesh``: its faces, the booleans computed by Manifold), whole
+        and exactly, whatever the tolerance: ``hausdorff_bound`` 0, up to the
+        rounding of the vertices the booleans create; a cube is 12 triangles.
     tolerance : float, optional
         The bound (world units, Euclidean) on the two-sided Hausdorff distance
         between the mesh and the surface. The largest cells are cubes of edge
@@ -107,9 +113,10 @@ def mesh(shape: Any, tolerance: Optional[float] = None,
     Raises
     ------
     ValueError
-        For bad options (the message names the parameter), and for solids whose
-        expression only bounds them (polyhedra: OpenSCAD's facets, imported
-        meshes), which have no point values to contour.
+        For bad options (the message names the parameter); for a solid whose
+        expression only bounds it and that has no closed mesh of its own (a
+        polyhedron beside a curved part, an open mesh); for bounds that cut a
+        polyhedral solid.
     MemoryError
         When the estimate, or the run, exceeds ``max_memory``.
     """
@@ -139,12 +146,9 @@ def mesh_grid(shape: Any, grid: Grid, run: Run, *, refine: int = REFINE,
     import pyvista as pv
 
     shape = as_shape(shape)
-    if not expression_is_exact(shape):
-        raise ValueError("this solid holds polyhedra (OpenSCAD's faceted spheres, extruded "
-                         "text and other long outlines, polyhedron(), imported meshes) whose "
-                         "expressions only bound them, and meshing needs the "
-                         "solid's own function: read OpenSCAD models with facets='true' (the "
-                         "true curves), or voxelize the solid")
+    found = boundary_mesh(shape)
+    if found is not None or not expression_is_exact(shape):
+        return _boundary(found, grid)
     func = Function(shape.expr)
     exact, exact_voxels = exact_classifier(shape), voxel_classifier(shape)
     estimate, estimated, need = estimate_meshing_memory(shape, grid, prune)
@@ -184,6 +188,39 @@ def mesh_grid(shape: Any, grid: Grid, run: Run, *, refine: int = REFINE,
                       "surface that no cell edge shows (detail below the finest cell, or a "
                       "tangency): the Hausdorff bound does not cover them; raise refine or "
                       "lower tolerance", UserWarning, stacklevel=3)
+    return out
+
+
+def _boundary(found: Optional[tuple], grid: Grid) -> Any:
+    """A polyhedral solid's mesh: its own closed boundary (``found``, from
+    ``boundary_mesh``; None: the solid has none), checked against the grid's box and
+    its edges counted."""
+    import pyvista as pv
+
+    t0 = time.perf_counter()
+    if found is None:
+        raise ValueError("this solid holds polyhedra (OpenSCAD's faceted spheres, extruded "
+                         "text and other long outlines, polyhedron(), imported meshes) whose "
+                         "expressions only bound them, beside a curved part or an open mesh: "
+                         "it has neither point values to contour nor a closed mesh of its "
+                         "own. Read OpenSCAD models with facets='true' (the true curves) or "
+                         "all in facets, or voxelize the solid")
+    points, triangles = found
+    lo, hi = (np.asarray(b, dtype=np.float64) for b in grid.bounds)
+    if len(points) and ((points.min(0) < lo).any() or (points.max(0) > hi).any()):
+        raise ValueError(f"bounds: a polyhedral solid is meshed whole, and its boundary "
+                         f"reaches {points.min(0).tolist()} - {points.max(0).tolist()}, past "
+                         f"the bounds {lo.tolist()} - {hi.tolist()}; give bounds that hold "
+                         "it, or none")
+    _, _, counts = edge_counts(triangles) if len(triangles) else (None, None, np.zeros(0))
+    faces = np.hstack([np.full((len(triangles), 1), 3, dtype=np.int64), triangles])
+    out = pv.PolyData(points, faces=faces.ravel()) if len(triangles) else pv.PolyData()
+    for key, value in (("hausdorff_bound", 0.0), ("linf_bound", 0.0), ("uncertified_cells", 0),
+                       ("complex_cells", 0), ("open_edges", int((counts == 1).sum())),
+                       ("non_manifold_edges", int((counts > 2).sum())), ("leaves", 0),
+                       ("seconds", time.perf_counter() - t0), ("workers", 1),
+                       ("implicitvox", __version__)):
+        out.field_data[key] = [value]
     return out
 
 

@@ -18,7 +18,7 @@ from implicitvox import min as vmin
 from implicitvox import sqrt, x, y, z
 from implicitvox.expr.examples import example
 from implicitvox.meshing.hausdorff import (distance_to_mesh, distance_to_surface, hausdorff,
-                                          surface_points)
+                                          mesh_samples, surface_points)
 from implicitvox.meshing.manifold import edge_counts
 from implicitvox.octree.grid import grid_of
 
@@ -204,9 +204,43 @@ def test_to_mesh_uses_the_voxels_grid_and_refuses_without_a_shape(tmp_path):
         ivx.load(vox.save(str(tmp_path / "v.npz"))).to_mesh()
 
 
-def test_polyhedra_are_refused_clearly():
-    # an imported mesh: its function is only a bound
-    solid = csg.read_openscad(str(FIXTURES / "imported.csg"), facets="openscad")
+@pytest.mark.parametrize("name", ["knob", "imported", "hulls", "drawing", "twisted"])
+def test_polyhedral_solids_are_their_own_boundary_within_the_stls_rounding(name):
+    """OpenSCAD models in facets mode (revolved and scaled extrusions, an imported
+    mesh, hulls, a twisted extrusion, with their differences): the mesh is the
+    regularized solid's boundary, watertight, at a symmetric Hausdorff distance from
+    OpenSCAD 2021.01's own STL within that file's rounding (6 significant digits)."""
+    import pyvista as pv
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", csg.OpenSCADWarning)
+        solid = csg.read_openscad(str(FIXTURES / f"{name}.csg"), facets="openscad")
+    m = ivx.mesh(solid, resolution=16)
+    assert m.field_data["hausdorff_bound"][0] == 0 and m.field_data["open_edges"][0] == 0
+    t = _trimesh(m)
+    assert t.is_watertight and t.is_winding_consistent and t.volume > 0
+    stl = pv.read(str(FIXTURES / f"{name}.stl"))
+    digits = 10.0 ** (np.floor(np.log10(np.abs(stl.points).max())) - 5)
+    allowed = math.sqrt(3) * 0.5 * digits                 # each coordinate rounded
+    ours, theirs = np.asarray(m.points), np.asarray(stl.points, dtype=np.float64)
+    assert distance_to_mesh(stl, mesh_samples(ours, m.regular_faces, 2)).max() <= allowed
+    assert distance_to_mesh(m, mesh_samples(theirs, stl.regular_faces, 2)).max() <= allowed
+
+
+def test_a_cube_is_twelve_triangles_and_bounds_that_cut_a_polyhedron_are_refused():
+    cube = csg.Box((2, 2, 2), center=True)
+    m = ivx.mesh(cube, resolution=64)
+    assert m.n_cells == 12 and m.field_data["hausdorff_bound"][0] == 0
+    assert np.allclose(np.abs(np.asarray(m.points)), 1.0)
+    with pytest.raises(ValueError, match="bounds"):
+        ivx.mesh(cube, resolution=8, bounds=((-0.5,) * 3, (1.5,) * 3))
+
+
+def test_a_polyhedron_beside_a_curved_part_is_refused_clearly():
+    # an imported mesh (its function is only a bound) beside a true sphere: no point
+    # values to contour, and no closed mesh of the whole
+    mesh = csg.read_openscad(str(FIXTURES / "imported.csg"), facets="true")
+    solid = mesh | csg.Sphere(1.0, center=tuple(np.mean(mesh.bounds, axis=0)))
+    assert not solid.expression_is_exact and solid.boundary_mesh is None
     with pytest.raises(ValueError, match="facets='true'"):
         ivx.mesh(solid, resolution=16)
 
