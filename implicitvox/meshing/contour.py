@@ -110,7 +110,7 @@ def dual_contour(func: Function, agrid: AdaptiveGrid, bound: float = np.inf,
     ``bound`` (Euclidean) is the distance a complex leaf's points may be from
     the nearest vertex of a leaf around it (:attr:`Contour.uncovered`);
     ``progress`` is called with the share done after each stage."""
-    from .contour_kernels import changed_edges, unique_edges    # (loads Numba)
+    from .contour_kernels import changed_edges, quad_triangles, unique_edges   # (Numba)
     share = progress if progress is not None else (lambda s: None)
     grid, depth = agrid.grid, agrid.grid.depth
     n = agrid.count
@@ -130,7 +130,7 @@ def dual_contour(func: Function, agrid: AdaptiveGrid, bound: float = np.inf,
     lo = np.stack([grid.edge(k, agrid.coords[:, k] * scale) for k in range(3)], 1)
     hi = np.stack([grid.edge(k, np.minimum((agrid.coords[:, k] + 1) * scale, grid.shape[k]))
                    for k in range(3)], 1)
-    vertex = solve(leaf, p[edge_of], nrm[edge_of], n, lo, hi)
+    vertex = solve(leaf, p, nrm, n, lo, hi, crossing=edge_of)
     share(0.6)
     # the cells around each edge: probes beside its midpoint, one per quadrant
     locator = _Locator(agrid)
@@ -145,7 +145,7 @@ def dual_contour(func: Function, agrid: AdaptiveGrid, bound: float = np.inf,
     quads = around[chosen]
     flip = ~low_inside[first[chosen]]             # f >= 0 at the lower end: normal -axis
     quads[flip] = quads[flip][:, ::-1]
-    faces = _triangles(quads, vertex)
+    faces = quad_triangles(np.ascontiguousarray(quads), vertex)
     has_vertex = np.zeros(n, dtype=bool)
     has_vertex[faces.ravel()] = True
     used = np.flatnonzero(has_vertex)
@@ -177,21 +177,3 @@ def _uncovered(agrid: AdaptiveGrid, locator: "_Locator", vertex: np.ndarray,
             far = np.linalg.norm(corners[ok] - vertex[j[ok]][:, None, :], axis=2).max(1)
             best[ok] = np.minimum(best[ok], far)
     return int((best > bound).sum())
-
-
-def _triangles(quads: np.ndarray, vertex: np.ndarray) -> np.ndarray:
-    """Quads (cyclic cell indices) to triangles: split along the shorter diagonal;
-    a quad with a cell twice (a coarse cell beside two finer ones) is one triangle."""
-    same = quads == np.roll(quads, -1, axis=1)             # position i equals i + 1
-    degenerate = same.any(1)
-    full = quads[~degenerate]
-    d02 = np.linalg.norm(vertex[full[:, 0]] - vertex[full[:, 2]], axis=1)
-    d13 = np.linalg.norm(vertex[full[:, 1]] - vertex[full[:, 3]], axis=1)
-    split02 = d02 <= d13
-    t1 = np.where(split02[:, None], full[:, [0, 1, 2]], full[:, [1, 2, 3]])
-    t2 = np.where(split02[:, None], full[:, [0, 2, 3]], full[:, [1, 3, 0]])
-    tri = []
-    one_repeat = degenerate & (same.sum(1) == 1)           # three distinct cells
-    if one_repeat.any():
-        tri.append(quads[one_repeat][~same[one_repeat]].reshape(-1, 3))
-    return np.concatenate([t1, t2] + tri) if len(full) or tri else np.zeros((0, 3), np.int64)

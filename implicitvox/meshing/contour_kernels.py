@@ -17,6 +17,8 @@ Examples
 """
 from __future__ import annotations
 
+import math
+
 import numpy as np
 from numba import njit
 
@@ -24,7 +26,7 @@ from ..interval.rules import COMPILE
 from ..octree.morton_kernels import encode_one
 
 __all__ = ["changed_edges", "unique_edges", "edge_cells", "find_leaf", "find_leaves",
-           "EDGE_START", "EDGE_END", "EDGE_AXIS"]
+           "quad_triangles", "EDGE_START", "EDGE_END", "EDGE_AXIS"]
 
 #: the 12 cell edges as start corner, end corner and axis, the start the lower end
 #: (corner ``c`` at offset ``(c & 1, c >> 1 & 1, c >> 2 & 1)``)
@@ -215,3 +217,52 @@ def edge_cells(start, axis, length, starts, ends, index, levels, shape, depth):
                                            probe[q, 2], level):
                 unmatched[e] = False
     return around, minimal, unmatched
+
+
+@njit(**COMPILE)
+def _length2(vertex, a, b):
+    d0 = vertex[a, 0] - vertex[b, 0]
+    d1 = vertex[a, 1] - vertex[b, 1]
+    d2 = vertex[a, 2] - vertex[b, 2]
+    return d0 * d0 + d1 * d1 + d2 * d2
+
+
+@njit(**COMPILE)
+def quad_triangles(quads, vertex):
+    """Quads (cyclic cell indices, ``(q, 4)``) to triangles: each split along its
+    shorter diagonal (the first triangles of all quads, then their second ones), a
+    quad with one cell twice (a coarse cell beside two finer ones) one triangle
+    (after those), a quad with fewer than three cells none."""
+    q = quads.shape[0]
+    full = 0
+    single = 0
+    for i in range(q):
+        repeats = 0
+        for k in range(4):
+            repeats += quads[i, k] == quads[i, (k + 1) % 4]
+        if repeats == 0:
+            full += 1
+        elif repeats == 1:
+            single += 1
+    out = np.empty((2 * full + single, 3), np.int64)
+    f = 0
+    t = 2 * full
+    for i in range(q):
+        a, b, c, d = quads[i, 0], quads[i, 1], quads[i, 2], quads[i, 3]
+        repeats = (a == b) + (b == c) + (c == d) + (d == a)
+        if repeats == 0:
+            if math.sqrt(_length2(vertex, a, c)) <= math.sqrt(_length2(vertex, b, d)):
+                out[f, 0], out[f, 1], out[f, 2] = a, b, c
+                out[full + f, 0], out[full + f, 1], out[full + f, 2] = a, c, d
+            else:
+                out[f, 0], out[f, 1], out[f, 2] = b, c, d
+                out[full + f, 0], out[full + f, 1], out[full + f, 2] = b, d, a
+            f += 1
+        elif repeats == 1:
+            k = 0
+            for j in range(4):
+                if quads[i, j] != quads[i, (j + 1) % 4]:
+                    out[t, k] = quads[i, j]
+                    k += 1
+            t += 1
+    return out

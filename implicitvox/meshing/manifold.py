@@ -74,6 +74,8 @@ def split_nonmanifold(points: np.ndarray, faces: np.ndarray
     # each group of corners a vertex, numbered as its first corner comes
     out_points = points[faces.ravel()[first_corner]]
     out_faces = label.reshape(-1, 3)
+    if not len(many):            # splitting vertices only parts an edge's triangles
+        return out_points, out_faces, 0
     _, _, after = edge_counts(out_faces)
     return out_points, out_faces, int((after > 2).sum())
 

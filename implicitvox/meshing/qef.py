@@ -23,6 +23,8 @@ Examples
 """
 from __future__ import annotations
 
+from typing import Optional
+
 import numpy as np
 
 __all__ = ["solve", "TRUNCATE"]
@@ -32,13 +34,18 @@ TRUNCATE = 0.1
 
 
 def solve(cell: np.ndarray, points: np.ndarray, normals: np.ndarray, n_cells: int,
-          lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+          lo: np.ndarray, hi: np.ndarray, crossing: Optional[np.ndarray] = None
+          ) -> np.ndarray:
     """The vertex ``(n_cells, 3)`` of each cell from its crossings.
 
-    ``cell[i]`` is the cell of crossing ``i``; ``lo, hi`` ``(n_cells, 3)`` the
-    cells' boxes. A cell without crossings gets its box centre."""
+    ``cell[i]`` is the cell of crossing ``i`` (of crossing ``crossing[i]`` when given:
+    a crossing shared by several cells is stored once); ``lo, hi`` ``(n_cells, 3)``
+    the cells' boxes. A cell without crossings gets its box centre."""
     from .qef_kernels import qef_vertices, quadric_sums          # (loads Numba)
-    count, mass, A, rhs = quadric_sums(np.asarray(cell, dtype=np.int64),
+    cell = np.asarray(cell, dtype=np.int64)
+    crossing = np.arange(len(cell)) if crossing is None else \
+        np.asarray(crossing, dtype=np.int64)
+    count, mass, A, rhs = quadric_sums(cell, crossing,
                                        np.ascontiguousarray(points, dtype=np.float64),
                                        np.ascontiguousarray(normals, dtype=np.float64), n_cells)
     return qef_vertices(count, mass, A, rhs, np.ascontiguousarray(lo, dtype=np.float64),

@@ -30,17 +30,18 @@ _PAIRS = np.array([(0, 1), (0, 2), (1, 2)], dtype=np.int64)
 
 
 @njit(**COMPILE)
-def quadric_sums(cell, points, normals, n_cells):
+def quadric_sums(cell, crossing, points, normals, n_cells):
     """Each cell's crossings count, mass point, and the normal equations of its
     quadric about the mass point: ``A = Σ n nᵀ``, ``b = Σ n nᵀ (p - m)`` (crossings
-    in order, one sum per cell)."""
+    in order, one sum per cell); row ``r`` is crossing ``points[crossing[r]]`` (with
+    its normal) in cell ``cell[r]``: edges shared by several cells are found once."""
     count = np.zeros(n_cells, np.int64)
     mass = np.zeros((n_cells, 3))
     for r in range(cell.shape[0]):
-        c = cell[r]
+        c, e = cell[r], crossing[r]
         count[c] += 1
         for a in range(3):
-            mass[c, a] += points[r, a]
+            mass[c, a] += points[e, a]
     for c in range(n_cells):
         if count[c]:
             for a in range(3):
@@ -48,14 +49,14 @@ def quadric_sums(cell, points, normals, n_cells):
     A = np.zeros((n_cells, 3, 3))
     rhs = np.zeros((n_cells, 3))
     for r in range(cell.shape[0]):
-        c = cell[r]
+        c, e = cell[r], crossing[r]
         d = 0.0
         for a in range(3):
-            d += normals[r, a] * (points[r, a] - mass[c, a])
+            d += normals[e, a] * (points[e, a] - mass[c, a])
         for i in range(3):
-            rhs[c, i] += normals[r, i] * d
+            rhs[c, i] += normals[e, i] * d
             for j in range(i, 3):
-                A[c, i, j] += normals[r, i] * normals[r, j]
+                A[c, i, j] += normals[e, i] * normals[e, j]
     for c in range(n_cells):
         for i in range(3):
             for j in range(i + 1, 3):
