@@ -89,7 +89,7 @@ def pool_gradients(pool: TapePool, tapes: np.ndarray, counts: np.ndarray, xs: np
          np.ascontiguousarray(counts, dtype=np.int64),
          np.ascontiguousarray(xs, dtype=np.float64), np.ascontiguousarray(ys, dtype=np.float64),
          np.ascontiguousarray(zs, dtype=np.float64), values, grads,
-         np.empty(registers), np.empty((3, registers)))
+         np.empty(registers), np.empty((3, registers)), 3)
     return values, grads
 
 
@@ -116,13 +116,11 @@ def pool_values(pool: TapePool, tapes: np.ndarray, counts: np.ndarray, xs: np.nd
         values[:] = np.nan
         return values
     registers = _registers(pool)
-    _run_values(pool.rows, pool.tapes, pool.params, pool.is_constant, pool.constant_value,
-                pool.inputs, np.ascontiguousarray(tapes, dtype=np.int64),
-                np.ascontiguousarray(counts, dtype=np.int64),
-                np.ascontiguousarray(xs, dtype=np.float64),
-                np.ascontiguousarray(ys, dtype=np.float64),
-                np.ascontiguousarray(zs, dtype=np.float64), values, np.empty(registers),
-                np.empty((3, registers)))
+    _run(pool.rows, pool.tapes, pool.params, pool.is_constant, pool.constant_value,
+         pool.inputs, np.ascontiguousarray(tapes, dtype=np.int64),
+         np.ascontiguousarray(counts, dtype=np.int64), np.ascontiguousarray(xs, dtype=np.float64),
+         np.ascontiguousarray(ys, dtype=np.float64), np.ascontiguousarray(zs, dtype=np.float64),
+         values, np.empty((3, 0)), np.empty(registers), np.empty((3, registers)), 0)
     return values
 
 
@@ -216,7 +214,7 @@ def tape_gradients(tape: Tape, xs: np.ndarray, ys: np.ndarray, zs: np.ndarray
     _run(rows, one, params, is_constant, constant_value, inputs, np.zeros(1, dtype=np.int64),
          np.array([count], dtype=np.int64), *(np.ascontiguousarray(v, dtype=np.float64)
                                               for v in (xs, ys, zs)),
-         values, grads, np.empty(registers), np.empty((3, registers)))
+         values, grads, np.empty(registers), np.empty((3, registers)), 3)
     return values, grads
 
 
@@ -370,29 +368,17 @@ def _at_point(rows, first, length, output, params, is_constant, constant_value, 
 
 @njit(**COMPILE)
 def _run(rows, tapes_, params, is_constant, constant_value, inputs, tapes, counts, xs, ys, zs,
-         values, grads, val, grad):
+         values, grads, val, grad, dims):
+    """The points in runs of pool tapes: values, and with ``dims = 3`` gradients."""
     start = 0
     for r in range(tapes.size):
         t = tapes[r]
         first, length, output = tapes_[t, START], tapes_[t, ROWS], tapes_[t, OUTPUT]
         for i in range(start, start + counts[r]):
             values[i] = _at_point(rows, first, length, output, params, is_constant,
-                                  constant_value, inputs, xs[i], ys[i], zs[i], val, grad, 3)
-            for d in range(3):
+                                  constant_value, inputs, xs[i], ys[i], zs[i], val, grad, dims)
+            for d in range(dims):
                 grads[d, i] = grad[d, output]
-        start += counts[r]
-
-
-@njit(**COMPILE)
-def _run_values(rows, tapes_, params, is_constant, constant_value, inputs, tapes, counts, xs,
-                ys, zs, values, val, grad):
-    start = 0
-    for r in range(tapes.size):
-        t = tapes[r]
-        first, length, output = tapes_[t, START], tapes_[t, ROWS], tapes_[t, OUTPUT]
-        for i in range(start, start + counts[r]):
-            values[i] = _at_point(rows, first, length, output, params, is_constant,
-                                  constant_value, inputs, xs[i], ys[i], zs[i], val, grad, 0)
         start += counts[r]
 
 
