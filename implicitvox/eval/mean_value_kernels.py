@@ -49,9 +49,9 @@ from .compiled import (ABS, ACOS, ADD, ADDC, ASIN, ATAN, ATAN2, COS, DISTANCE, D
                        ELEVATION, EXP, HYPOT, LOG, MAX, MIN, MUL, MULC, NEG,
                        PERIODIC_ANGLE, POWI, POWR, RADIUS, RSUBC, SIN, SQRT, SQUARE, SUB, TAN,
                        compiled_tape)
-from .pool_gradients import POINT_OPS, numpy_maximum, numpy_minimum, takes_pool
+from .pool_gradients import POINT_OPS, check_runs, numpy_maximum, numpy_minimum, takes_pool
 from .tape import Tape
-from .tape_pool import OUTPUT, REGISTERS, ROWS, START, VALUE, TapePool
+from .tape_pool import OUTPUT, ROWS, START, VALUE, TapePool
 
 __all__ = ["tape_interval_gradients", "pool_interval_gradients"]
 
@@ -104,15 +104,14 @@ def pool_interval_gradients(pool: TapePool, tapes: np.ndarray, counts: np.ndarra
     lo = np.ascontiguousarray(np.asarray(lo, dtype=np.float64).reshape(3, -1))
     hi = np.ascontiguousarray(np.asarray(hi, dtype=np.float64).reshape(3, -1))
     n = lo.shape[1]
-    if int(np.sum(counts)) != n:
-        raise ValueError(f"the runs cover {int(np.sum(counts))} boxes, not {n}")
+    check_runs(counts, n)
     vlo, vhi = np.empty(n), np.empty(n)
     glo, ghi = np.empty((3, n)), np.empty((3, n))
     valid = np.ones(n, dtype=np.bool_)
     rows = pool.rows[:max(pool.rows_used, 1)]
     row_params = pool.params[rows[:, VALUE]]
     creg = np.flatnonzero(pool.is_constant)
-    registers = max(int(pool.tapes[:len(pool), REGISTERS].max()), pool.fixed, 1)
+    registers = pool.registers
     _run_pool(rows, row_params, pool.tapes, creg, pool.constant_lo[creg],
               pool.constant_hi[creg], pool.inputs, np.ascontiguousarray(tapes, dtype=np.int64),
               np.ascontiguousarray(counts, dtype=np.int64), lo, hi, vlo, vhi, glo, ghi, valid,

@@ -53,9 +53,9 @@ from .tape import Tape
 from .tape_pool import (ARG_A, ARG_B, ARG_C, OP, OUT, OUTPUT, ROW, ROWS, START, VALUE,
                         TapePool)
 
-__all__ = ["pool_gradients", "pool_values", "pool_crossings", "takes_pool", "tape_arrays",
-           "tape_gradients", "crossing_points", "TapeArrays", "POINT_OPS", "numpy_minimum",
-           "numpy_maximum"]
+__all__ = ["pool_gradients", "pool_values", "pool_crossings", "check_runs", "takes_pool",
+           "tape_arrays", "tape_gradients", "crossing_points", "TapeArrays", "POINT_OPS",
+           "numpy_minimum", "numpy_maximum"]
 
 #: the operations :func:`pool_gradients` runs (numbers of :data:`implicitvox.eval.compiled.OPS`)
 POINT_OPS = frozenset((ADD, SUB, MUL, DIV, NEG, SQUARE, SQRT, ABS, MIN, MAX, ADDC, RSUBC, MULC,
@@ -78,12 +78,12 @@ def pool_gradients(pool: TapePool, tapes: np.ndarray, counts: np.ndarray, xs: np
     if not takes_pool(pool):
         return None
     n = len(xs)
-    _runs_cover(counts, n)
+    check_runs(counts, n)
     values, grads = np.empty(n), np.empty((3, n))
     if pool.undefined:
         values[:], grads[:] = np.nan, np.nan
         return values, grads
-    registers = _registers(pool)
+    registers = pool.registers
     _run(pool.rows, pool.tapes, pool.params, pool.is_constant, pool.constant_value,
          pool.inputs, np.ascontiguousarray(tapes, dtype=np.int64),
          np.ascontiguousarray(counts, dtype=np.int64),
@@ -93,15 +93,10 @@ def pool_gradients(pool: TapePool, tapes: np.ndarray, counts: np.ndarray, xs: np
     return values, grads
 
 
-def _registers(pool: TapePool) -> int:
-    """Registers a pool tape may use (the fixed ones included)."""
-    used = int(pool.tapes[:len(pool), 4].max()) if len(pool) else 0
-    return max(used, pool.fixed, 1)
-
-
-def _runs_cover(counts: np.ndarray, n: int) -> None:
+def check_runs(counts: np.ndarray, n: int) -> None:
+    """Raise ``ValueError`` unless runs of ``counts`` rows cover exactly ``n`` rows."""
     if int(np.sum(counts)) != n:
-        raise ValueError(f"the runs cover {int(np.sum(counts))} points, not {n}")
+        raise ValueError(f"the runs cover {int(np.sum(counts))} rows, not {n}")
 
 
 def pool_values(pool: TapePool, tapes: np.ndarray, counts: np.ndarray, xs: np.ndarray,
@@ -110,12 +105,12 @@ def pool_values(pool: TapePool, tapes: np.ndarray, counts: np.ndarray, xs: np.nd
     derivatives), or None (:func:`takes_pool`)."""
     if not takes_pool(pool):
         return None
-    _runs_cover(counts, len(xs))
+    check_runs(counts, len(xs))
     values = np.empty(len(xs))
     if pool.undefined:
         values[:] = np.nan
         return values
-    registers = _registers(pool)
+    registers = pool.registers
     _run(pool.rows, pool.tapes, pool.params, pool.is_constant, pool.constant_value,
          pool.inputs, np.ascontiguousarray(tapes, dtype=np.int64),
          np.ascontiguousarray(counts, dtype=np.int64), np.ascontiguousarray(xs, dtype=np.float64),
@@ -131,10 +126,10 @@ def pool_crossings(pool: TapePool, tapes: np.ndarray, counts: np.ndarray, a: np.
     tape built alone, or None (:func:`takes_pool`, or an undefined pool)."""
     if not takes_pool(pool) or pool.undefined:
         return None
-    _runs_cover(counts, len(a))
+    check_runs(counts, len(a))
     a = np.ascontiguousarray(a, dtype=np.float64)
     points = np.empty_like(a)
-    registers = _registers(pool)
+    registers = pool.registers
     _bisect_runs(pool.rows, pool.tapes, pool.params, pool.is_constant, pool.constant_value,
                  pool.inputs, np.ascontiguousarray(tapes, dtype=np.int64),
                  np.ascontiguousarray(counts, dtype=np.int64), a,

@@ -174,6 +174,12 @@ class TapePool:
         return int(self.used[USED_ROWS])
 
     @property
+    def registers(self) -> int:
+        """Registers a run of any of its tapes needs (the fixed ones included)."""
+        used = int(self.tapes[:len(self), REGISTERS].max()) if len(self) else 0
+        return max(used, self.fixed, 1)
+
+    @property
     def ran_out(self) -> bool:
         """Whether a run since the last :meth:`grow` found no room for a tape (its
         octants kept their parents' tapes)."""

@@ -82,12 +82,19 @@ def changed_edges(corners, levels, coords, depth):
 
 
 @njit(**COMPILE)
+def _log2(length):
+    """The exponent of a power of 2: the levels an edge of this length lies above the
+    finest."""
+    k = 0
+    while (np.int64(1) << k) < length:
+        k += 1
+    return k
+
+
+@njit(**COMPILE)
 def _tag(axis, length):
-    """Axis and length of an edge in one number (lengths are powers of 2)."""
-    level = 0
-    while (np.int64(1) << level) < length:
-        level += 1
-    return np.uint64(axis + 4 * level)
+    """Axis and length of an edge in one number."""
+    return np.uint64(axis + 4 * _log2(length))
 
 
 @njit(**COMPILE)
@@ -188,9 +195,7 @@ def edge_cells(start, axis, length, starts, ends, index, levels, shape, depth):
         u = (a + 1) % 3
         v = (a + 2) % 3
         size = length[e]
-        level = depth
-        while (np.int64(1) << (depth - level)) < size:
-            level -= 1
+        level = depth - _log2(size)
         complete = True
         within = True
         for q in range(4):
