@@ -78,7 +78,7 @@ _CHUNK = 1 << 14
 #: the cells take the pruned tape of their ancestor this many levels above the
 #: tolerance level's voxels (valid over them all). With a Python call per tape, a tape
 #: per voxel or two cost more than the shorter tapes saved (the level-3 sponge at 128:
-#: 24.5 s at 0, 11.9 at 3); on the pool's rows (:mod:`.cell_tapes`) 1 is best (3.0-3.1 s
+#: 24.5 s at 0, 11.9 at 3); on the pool's rows (:mod:`.cell_tapes`) 1 is best (2.85-3.14 s
 #: at 1, 3.45-3.55 s at 3, alternately; the same mesh)
 LEAF_LEVELS_UP = 1
 #: a gradient component counts as one-signed when its other side is within this

@@ -3,8 +3,9 @@ each cell's crossings and their truncated pseudo-inverse solve.
 
 The eigen-decomposition of each cell's symmetric 3×3 matrix is Jacobi's method
 (cyclic rotations, each zeroing one off-diagonal entry, Golub and Van Loan
-§8.5), as dual-contouring codes do per cell; a batched LAPACK call costs about
-10 times more per 3×3 matrix.
+§8.5), as dual-contouring codes do per cell: on the sphere at 256 the whole
+solve takes 0.10 s, where numpy's batched LAPACK ``eigh`` alone took 0.33 s
+(about 1.6 µs per 3×3 matrix; Numba's ``np.linalg.eigh`` per matrix 1.8 µs).
 
 Examples
 --------
