@@ -117,15 +117,17 @@ def band_distances(spec: DistanceKernel, grid: Grid, weights: np.ndarray, coords
 
 
 def mesh_band_distances(mesh: TriangleMesh, grid: Grid, norm: str, weights: np.ndarray,
-                        keys: np.ndarray, active: np.ndarray, band: int, run: Run
+                        keys: np.ndarray, steps: np.ndarray, band: int, run: Run
                         ) -> tuple[np.ndarray, int]:
-    """A mesh's values at the band's samples (``brick_coords(keys)[active]``), signed
+    """A mesh's values at the band's samples (``brick_coords(keys)[active]``, ``active``
+    where ``steps <= band``: :func:`implicitvox.fields.bricks.band_steps`), signed
     where it is closed, by its triangles scattered over the bricks
     (:func:`implicitvox.fields.mesh_band.mesh_band`, threads over ranges of
     bricks), and the workers used."""
+    active = steps <= band
     count = int(active.sum())
     n = run.workers_for(count * COST["mesh"])
-    values = mesh_band(mesh, grid, keys, active, band, norm, weights, workers=n,
+    values = mesh_band(mesh, grid, keys, active, band, norm, weights, steps=steps, workers=n,
                        executor=run.executor, progress=run.progress)
     if mesh.closed:
         values = mesh.with_sign(grid.centers(masked_coords(keys, active)), values)

@@ -32,34 +32,35 @@ def brick_row(keys, i, j, k):
 
 
 @njit(**COMPILE)
-def _window_any(src, n, width, dst):
-    """``dst[i] = any(src[i:i + width])`` for ``i < n`` (a running count)."""
-    count = 0
-    for x in range(width - 1):
-        count += src[x]
-    for i in range(n):
-        count += src[i + width - 1]
-        dst[i] = count > 0
-        count -= src[i]
+def _least(line, at, band, far):
+    """``min(far, max(|d|, line[at + d]))`` over ``|d| <= band``, nearest offsets first
+    (none farther than the least so far can lower it)."""
+    least = min(far, line[at])
+    for d in range(1, band + 1):
+        if d >= least:
+            break
+        least = min(least, max(d, min(line[at - d], line[at + d])))
+    return least
 
 
 @njit(**COMPILE)
-def band_samples(bricks, candidates, start, voxels, band, shape, active):
-    """The band's samples of each candidate brick into ``active`` (c, 8, 8, 8): those
-    inside the grid ``shape`` within ``band`` (per axis) of a surface voxel.
+def band_samples(bricks, candidates, start, voxels, band, shape, steps):
+    """The band's samples of each candidate brick into ``steps`` (c, 8, 8, 8): each
+    sample's Chebyshev distance, in voxels, to the nearest surface voxel where it is
+    at most ``band`` and the sample lies inside the grid ``shape``, else ``band + 1``.
 
     ``bricks`` (sorted codes) are the bricks holding surface voxels, brick
     ``u``'s voxels are ``voxels[start[u]:start[u + 1]]``; ``candidates`` (c, 3)
     are brick indices. Each candidate marks the surface voxels in its apron (the
-    brick grown by ``band``) and dilates the marks by ``2 band + 1`` along each
-    axis in turn (the window's running count along each line)."""
+    brick grown by ``band``), then takes the distance along x to the nearest mark,
+    and along y and z in turn the least ``max(|offset|, distance so far)`` within
+    ``band`` (the max-norm distance transform, separable)."""
     side = BRICK + 2 * band
+    far = band + 1
     reach = (band + BRICK - 1) // BRICK
-    marks = np.zeros((side, side, side), dtype=np.int64)
-    line = np.zeros(side, dtype=np.int64)
-    out = np.zeros(BRICK, dtype=np.bool_)
-    along_x = np.zeros((BRICK, side, side), dtype=np.int64)
-    along_y = np.zeros((BRICK, BRICK, side), dtype=np.int64)
+    marks = np.zeros((side, side, side), dtype=np.bool_)
+    along_x = np.empty((BRICK, side, side), dtype=np.int64)
+    along_y = np.empty((BRICK, BRICK, side), dtype=np.int64)
     lit = np.zeros((side, side), dtype=np.bool_)
     for c in range(candidates.shape[0]):
         ci, cj, ck = candidates[c, 0], candidates[c, 1], candidates[c, 2]
@@ -76,31 +77,33 @@ def band_samples(bricks, candidates, start, voxels, band, shape, active):
                         y = voxels[v, 1] - base[1]
                         z = voxels[v, 2] - base[2]
                         if 0 <= x < side and 0 <= y < side and 0 <= z < side:
-                            marks[x, y, z] = 1
+                            marks[x, y, z] = True
                             lit[y, z] = True
                             any_mark = True
+        steps[c] = far
         if not any_mark:
             continue
-        along_x[:] = 0
         for y in range(side):                 # along x, on the lines that hold a mark
             for z in range(side):
+                for i in range(BRICK):
+                    along_x[i, y, z] = far
                 if not lit[y, z]:
                     continue
-                for x in range(side):
-                    line[x] = marks[x, y, z]
-                    marks[x, y, z] = 0
-                _window_any(line, BRICK, 2 * band + 1, out)
                 for i in range(BRICK):
-                    along_x[i, y, z] = out[i]
+                    for d in range(band + 1):
+                        if marks[band + i - d, y, z] or marks[band + i + d, y, z]:
+                            along_x[i, y, z] = d
+                            break
+                for x in range(side):
+                    marks[x, y, z] = False
                 lit[y, z] = False
         for i in range(BRICK):                # along y
             for z in range(side):
-                _window_any(along_x[i, :, z], BRICK, 2 * band + 1, out)
                 for j in range(BRICK):
-                    along_y[i, j, z] = out[j]
+                    along_y[i, j, z] = _least(along_x[i, :, z], band + j, band, far)
         for i in range(BRICK):                # along z, inside the grid
             for j in range(BRICK):
-                _window_any(along_y[i, j], BRICK, 2 * band + 1, out)
+                inside = ci * BRICK + i < shape[0] and cj * BRICK + j < shape[1]
                 for k in range(BRICK):
-                    active[c, i, j, k] = out[k] and ci * BRICK + i < shape[0] and \
-                        cj * BRICK + j < shape[1] and ck * BRICK + k < shape[2]
+                    if inside and ck * BRICK + k < shape[2]:
+                        steps[c, i, j, k] = _least(along_y[i, j], band + k, band, far)

@@ -11,9 +11,10 @@ The band is stored as the bricks that hold a band voxel: sorted Morton
 codes of the bricks' indices, and per brick a ``(8, 8, 8)`` block of
 samples. Finding the band is compiled (:func:`implicitvox.fields.brick_kernels.band_samples`):
 the bricks near a brick holding surface voxels are the candidates; each
-marks the surface voxels in its apron (the brick grown by ``b``) and dilates
-them by ``2b + 1`` along each axis in turn; those left with a sample are the
-band's.
+marks the surface voxels in its apron (the brick grown by ``b``) and takes
+each sample's max-norm distance to the marks, in index steps, one axis at a
+time (:func:`band_steps`; the band's samples are those at most ``b`` steps
+away); those left with a sample are the band's.
 
 Examples
 --------
@@ -28,7 +29,7 @@ import numpy as np
 
 from ..octree import morton
 
-__all__ = ["BRICK", "band_bricks", "all_bricks", "brick_coords", "masked_coords", "in_grid",
+__all__ = ["BRICK", "band_bricks", "band_steps", "all_bricks", "brick_coords", "masked_coords", "in_grid",
            "BrickIndex", "MAX_BAND"]
 
 #: samples per brick edge
@@ -50,10 +51,29 @@ def band_bricks(surface: np.ndarray, band: int, shape: tuple[int, int, int]
         The band's samples in each brick (inside the grid, within ``band`` of a
         surface voxel per axis); every brick holds one.
     """
+    keys, steps = band_steps(surface, band, shape)
+    return keys, steps <= band
+
+
+def band_steps(surface: np.ndarray, band: int, shape: tuple[int, int, int]
+               ) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`band_bricks` with, per sample, its distance in voxels to the surface voxels.
+
+    Returns
+    -------
+    keys : ndarray of uint64, shape (k,)
+        As for :func:`band_bricks`.
+    steps : ndarray of uint8, shape (k, 8, 8, 8)
+        The Chebyshev distance (index steps, the largest over the axes) from each
+        sample to the nearest surface voxel: 0 on the surface voxels, at most
+        ``band`` on the band's samples, ``band + 1`` elsewhere. A surface point
+        lies in that voxel, so it lies within ``steps + 1/2`` voxels of the
+        sample along each axis: an upper bound of the sample's distance.
+    """
     from .brick_kernels import band_samples        # (loads Numba: not at import)
     surface = np.asarray(surface, dtype=np.int64).reshape(-1, 3)
     if not len(surface):
-        return np.zeros(0, dtype=np.uint64), np.zeros((0, BRICK, BRICK, BRICK), dtype=bool)
+        return np.zeros(0, dtype=np.uint64), np.zeros((0, BRICK, BRICK, BRICK), dtype=np.uint8)
     codes = morton.encode(surface >> _BITS)
     if np.any(codes[1:] < codes[:-1]):
         order = np.argsort(codes, kind="stable")
@@ -67,11 +87,11 @@ def band_bricks(surface: np.ndarray, band: int, shape: tuple[int, int, int]
     near = (morton.decode(bricks)[:, None, :] + offsets[None]).reshape(-1, 3)
     near = near[np.all((near >= 0) & (near < -(-np.asarray(shape) // BRICK)), axis=1)]
     keys = np.unique(morton.encode(near))
-    active = np.zeros((len(keys), BRICK, BRICK, BRICK), dtype=bool)
+    steps = np.empty((len(keys), BRICK, BRICK, BRICK), dtype=np.uint8)
     band_samples(bricks, morton.decode(keys), start, surface, band,
-                 np.asarray(shape, dtype=np.int64), active)
-    held = active.any(axis=(1, 2, 3))
-    return keys[held], active[held]
+                 np.asarray(shape, dtype=np.int64), steps)
+    held = (steps <= band).any(axis=(1, 2, 3))
+    return keys[held], steps[held]
 
 
 def all_bricks(shape: tuple[int, int, int]) -> tuple[np.ndarray, np.ndarray]:

@@ -98,10 +98,15 @@ class _BandJob(Job):
     """The triangles, bricks and grid every range of bricks shares (threads)."""
 
     def __init__(self, mesh: TriangleMesh, grid: Grid, keys: np.ndarray, active: np.ndarray,
-                 weights: np.ndarray, margin: np.ndarray, euclidean: bool):
+                 weights: np.ndarray, margin: np.ndarray, euclidean: bool,
+                 steps: Optional[np.ndarray], scale: float):
         super().__init__()
         self.mesh, self.grid, self.active, self.weights = mesh, grid, active, weights
         self.margin, self.euclidean = margin, euclidean
+        # the starting bounds: steps + 1/2 voxels, with room for rounding
+        self.steps = np.zeros((0, BRICK, BRICK, BRICK), dtype=np.uint8) if steps is None \
+            else steps
+        self.unit = np.array([scale * (1 + _SLACK), _SLACK * min(grid.voxel_size)])
         self.origins, self.centres = _layout(keys, grid)
         self.start, self.triangles = _kernels().brick_triangles(mesh.axes, keys, self.origins,
                                                                 self.centres, margin)
@@ -112,14 +117,14 @@ class _BandJob(Job):
         values = np.where(self.active[b0:b1], np.inf, -np.inf)
         _kernels().scatter_bricks(b0, b1, self.start, self.triangles, self.mesh.axes,
                                   self.mesh.tri, self.origins, self.centres, self.weights,
-                                  self.margin, self.euclidean, values)
+                                  self.margin, self.euclidean, self.steps, self.unit, values)
         return values
 
 
 def mesh_band(mesh: TriangleMesh, grid: Grid, keys: np.ndarray, active: np.ndarray,
-              band: int, norm: str = "linf", weights: Any = None, *, workers: int = 1,
-              executor: Any = None, progress: Optional[Callable[[float], Any]] = None
-              ) -> np.ndarray:
+              band: int, norm: str = "linf", weights: Any = None, *,
+              steps: Optional[np.ndarray] = None, workers: int = 1, executor: Any = None,
+              progress: Optional[Callable[[float], Any]] = None) -> np.ndarray:
     """Unsigned distances from ``mesh`` at the band's samples.
 
     Parameters
@@ -136,6 +141,12 @@ def mesh_band(mesh: TriangleMesh, grid: Grid, keys: np.ndarray, active: np.ndarr
         The weighted max-norm, or the Euclidean distance.
     weights : (3,) array, optional
         The max-norm's weights (voxel size over its longest edge); default 1.
+    steps : ndarray of uint8, (k, 8, 8, 8), optional
+        Each sample's distance in voxels to the nearest surface voxel
+        (:func:`implicitvox.fields.bricks.band_steps`). A sample starts from the
+        bound it gives, ``steps + 1/2`` voxels per axis, so that only the triangles
+        nearer than that are measured (the values are the same: a sample no
+        triangle comes below it on is walked).
     workers : int, default: 1
         Threads over ranges of bricks (the same values for any number).
     executor, progress
@@ -154,9 +165,11 @@ def mesh_band(mesh: TriangleMesh, grid: Grid, keys: np.ndarray, active: np.ndarr
     # a band sample's distance is at most its offset from a point of a surface voxel:
     # (band + 1/2) voxels per axis; the nearest point lies that far per axis (max norm,
     # weighted) or that offset's length along any axis (Euclidean)
-    limit = (band + 0.5) * (float(np.linalg.norm(h)) if euclidean else float(h.max()))
+    scale = float(np.linalg.norm(h)) if euclidean else float(h.max())
+    limit = (band + 0.5) * scale
     reach = np.full(3, limit) if euclidean else (band + 0.5) * h
-    job = _BandJob(mesh, grid, keys, active, w, reach * (1 + _SLACK) + _SLACK * h, euclidean)
+    job = _BandJob(mesh, grid, keys, active, w, reach * (1 + _SLACK) + _SLACK * h, euclidean,
+                   steps, scale)
     pieces = _pieces(job.start)
     values = np.empty(active.shape)
     if workers > 1 or executor is not None:
@@ -170,8 +183,10 @@ def mesh_band(mesh: TriangleMesh, grid: Grid, keys: np.ndarray, active: np.ndarr
         values[b0:b1] = part
         if progress is not None and workers <= 1 and executor is None:
             progress(b1 / max(len(keys), 1))
+    # beyond every triangle's reach, or no triangle below its starting bound (left at inf;
+    # none where the voxelization holds): the walk over all of them
     far = active & (values > limit)
-    if far.any():          # beyond every triangle's reach: the walk over all of them
+    if far.any():
         points = grid.centers(masked_coords(keys, far))
         values[far] = np.abs(mesh.euclidean_distance(points) if euclidean else
                              mesh.distance(points, np.broadcast_to(w, points.shape)))

@@ -93,20 +93,27 @@ def _side(r, a, p, w, euclidean):
 
 @njit(**COMPILE)
 def scatter_bricks(b0, b1, start, triangles, rows, tri, origins, centres, w, margin,
-                   euclidean, values):
+                   euclidean, steps, unit, values):
     """Bricks ``b0`` to ``b1``: each listed triangle's exact distance (max-norm, or
     Euclidean), where below the value held, into ``values[b - b0]`` at the samples
     within ``margin`` of its box (samples to skip hold -inf). A triangle whose box
     lies farther than the value held is skipped (the Euclidean box a relative
     :data:`~implicitvox.linf.mesh_walk.EUCLIDEAN_SLACK` farther: its distance and
-    the triangle's round differently)."""
+    the triangle's round differently).
+
+    With ``steps`` (per sample, voxels to the nearest surface voxel; empty: none),
+    a sample starts from the bound ``unit[0] * (steps + 1/2) + unit[1]`` instead
+    of the value held, and is left at inf where no triangle came below it."""
     keep = 1.0 + EUCLIDEAN_SLACK
     cx, cy, cz = centres
     w0, w1, w2 = w[0], w[1], w[2]
     sides = np.empty(BRICK)
+    bounded = steps.shape[0] > 0
     for b in range(b0, b1):
         o0, o1, o2 = origins[b, 0], origins[b, 1], origins[b, 2]
         out = values[b - b0]
+        if bounded:
+            _start_bounds(out, steps[b], unit, 1.0)
         for j in range(start[b], start[b + 1]):
             t = triangles[j]
             r = rows[t]
@@ -140,6 +147,23 @@ def scatter_bricks(b0, b1, start, triangles, rows, tri, origins, centres, w, mar
                             d = linf_below(p0, p1, cz[o2 + i2], w0, w1, w2, r, box, best)
                         if d < best:
                             row[i2] = d
+        if bounded:
+            _start_bounds(out, steps[b], unit, -1.0)
+
+
+@njit(**COMPILE)
+def _start_bounds(out, steps, unit, way):
+    """``way`` 1: the samples to compute (``out > 0``) start from their bound; -1: those
+    still at it (no triangle came below) go to inf."""
+    for i in range(BRICK):
+        for j in range(BRICK):
+            for k in range(BRICK):
+                if out[i, j, k] > 0.0:
+                    bound = unit[0] * (steps[i, j, k] + 0.5) + unit[1]
+                    if way > 0:
+                        out[i, j, k] = bound
+                    elif out[i, j, k] >= bound:
+                        out[i, j, k] = np.inf
 
 
 @njit(**COMPILE)

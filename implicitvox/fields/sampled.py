@@ -33,7 +33,7 @@ from ..triangles.inputs import as_triangles
 from ..triangles.weld import weld
 from ..voxelizers.implicit import voxelize
 from ..voxelizers.mesh import voxelize_mesh
-from .bricks import BRICK, MAX_BAND, all_bricks, band_bricks, in_grid, masked_coords
+from .bricks import BRICK, MAX_BAND, all_bricks, band_steps, in_grid, masked_coords
 from .band_chunks import DistanceKernel, band_distances, mesh_band_distances
 from .field import NORMS, DistanceField
 from .suitability import CRITICAL_RADIUS, SUITABILITY_CHECK_LIMIT, is_suitable_at, solid_voxels
@@ -144,8 +144,10 @@ def distance_field(shape: Any, resolution: Union[int, tuple[int, int, int], None
     t0 = time.perf_counter()
     first = run.part(0.0, 0.2)
     if mesh is not None:
-        # the triangles with their shared vertices again (the fill needs the connectivity)
-        vertices, corners = weld(mesh.tri.reshape(-1, 3))
+        # a closed mesh's triangles with their shared vertices again (the fill needs the
+        # connectivity); an open one's as they are (the surface voxels are the same)
+        vertices, corners = weld(mesh.tri.reshape(-1, 3)) if mesh.closed else \
+            (mesh.tri.reshape(-1, 3), np.arange(3 * len(mesh.tri)))
         vox = voxelize_mesh((vertices, corners.reshape(-1, 3)),
                             resolution, bounds=bounds, voxel_size=voxel_size,
                             interior=mesh.closed, max_memory=first.budget,
@@ -161,8 +163,11 @@ def distance_field(shape: Any, resolution: Union[int, tuple[int, int, int], None
         validate.positive_number(tolerance, "tolerance")
     weights = h / h.max()
     surface = vox.coords()
-    keys, active = band_bricks(surface, band, grid.shape) if band is not None else \
-        all_bricks(grid.shape)
+    if band is None:
+        keys, active = all_bricks(grid.shape)
+    else:
+        keys, steps = band_steps(surface, band, grid.shape)
+        active = steps <= band
     run.refuse(estimate_bytes(len(keys)),
                f"a distance field of {len(keys):,} bricks at {grid.shape}")
     # where the certified search looks first (it widens where no zero is proved)
@@ -174,7 +179,7 @@ def distance_field(shape: Any, resolution: Union[int, tuple[int, int, int], None
         spec.boxes = _surface_boxes(vox)
     kernel = spec.kernel
     if mesh is not None and band is not None:
-        values_band, used = mesh_band_distances(mesh, grid, norm, weights, keys, active, band,
+        values_band, used = mesh_band_distances(mesh, grid, norm, weights, keys, steps, band,
                                                 run.part(0.2, 1.0))
         errors_band = np.zeros(len(values_band))
     else:

@@ -6,7 +6,7 @@ import pytest
 import pyvista as pv
 from scipy import ndimage
 
-from implicitvox.fields.bricks import BRICK, band_bricks, masked_coords
+from implicitvox.fields.bricks import BRICK, band_bricks, band_steps, masked_coords
 from implicitvox.fields.mesh_band import mesh_band
 from implicitvox.linf import TriangleMesh
 from implicitvox.octree import morton
@@ -27,6 +27,13 @@ def test_band_bricks_are_the_dilation_of_the_surface_voxels(band):
     assert len(got) == truth.sum()
     assert truth[tuple(got.T)].all()
     assert np.array_equal(keys, np.unique(morton.encode(np.argwhere(truth) // BRICK)))
+    # the steps: scipy's chessboard transform of the voxels off the surface, capped
+    keys, steps = band_steps(surface, band, shape)
+    chess = np.minimum(ndimage.distance_transform_cdt(~dense, metric="chessboard"), band + 1)
+    coords = masked_coords(keys, np.ones(steps.shape, dtype=bool))
+    inside = np.all(coords < shape, axis=1)
+    assert np.array_equal(steps.reshape(-1)[inside], chess[tuple(coords[inside].T)])
+    assert np.all(steps.reshape(-1)[~inside] == band + 1)
 
 
 def _mesh_and_band(band):
@@ -38,11 +45,11 @@ def _mesh_and_band(band):
     vox = voxelize_mesh((v, f), (52, 60, 25), bounds=((-1.3, -1.2, -0.8), (1.3, 1.2, 0.825)))
     assert len(set(vox.grid.voxel_size)) == 3                # not cubes
     keys, active = band_bricks(vox.coords(), band, vox.grid.shape)
-    return mesh, vox.grid, keys, active
+    return mesh, vox.grid, keys, active, vox.coords()
 
 
 def test_the_scattered_band_is_the_walk_bit_for_bit_on_any_number_of_threads():
-    mesh, grid, keys, active = _mesh_and_band(3)
+    mesh, grid, keys, active, _ = _mesh_and_band(3)
     h = np.asarray(grid.voxel_size)
     w = h / h.max()
     points = grid.centers(masked_coords(keys, active))
@@ -57,8 +64,25 @@ def test_the_scattered_band_is_the_walk_bit_for_bit_on_any_number_of_threads():
     assert np.array_equal(mesh_band(mesh, grid, keys, active, 3, "euclidean", workers=2), one)
 
 
+def test_the_surface_voxels_bounds_start_the_samples_and_change_no_value():
+    mesh, grid, keys, active, surface = _mesh_and_band(3)
+    h = np.asarray(grid.voxel_size)
+    w = h / h.max()
+    same_keys, steps = band_steps(surface, 3, grid.shape)
+    assert np.array_equal(same_keys, keys) and np.array_equal(steps <= 3, active)
+    for norm in ("linf", "euclidean"):
+        plain = mesh_band(mesh, grid, keys, active, 3, norm, w)
+        assert np.array_equal(mesh_band(mesh, grid, keys, active, 3, norm, w, steps=steps),
+                              plain)
+        # bounds that are wrong (too low everywhere): no triangle comes below them, and
+        # the walk gives every value
+        low = np.zeros_like(steps)
+        assert np.array_equal(mesh_band(mesh, grid, keys, active, 3, norm, w, steps=low),
+                              plain)
+
+
 def test_samples_beyond_every_triangles_reach_are_walked():
-    mesh, grid, keys, active = _mesh_and_band(1)
+    mesh, grid, keys, active, _ = _mesh_and_band(1)
     everywhere = np.ones_like(active)          # far more than the band of 1 voxel
     w = np.asarray(grid.voxel_size) / max(grid.voxel_size)
     points = grid.centers(masked_coords(keys, everywhere))
