@@ -107,7 +107,9 @@ def scatter_bricks(b0, b1, start, triangles, rows, tri, origins, centres, w, mar
     keep = 1.0 + EUCLIDEAN_SLACK
     cx, cy, cz = centres
     w0, w1, w2 = w[0], w[1], w[2]
-    sides = np.empty(BRICK)
+    s0 = np.empty(BRICK)
+    s1 = np.empty(BRICK)
+    s2 = np.empty(BRICK)
     bounded = steps.shape[0] > 0
     for b in range(b0, b1):
         o0, o1, o2 = origins[b, 0], origins[b, 1], origins[b, 2]
@@ -117,36 +119,44 @@ def scatter_bricks(b0, b1, start, triangles, rows, tri, origins, centres, w, mar
         for j in range(start[b], start[b + 1]):
             t = triangles[j]
             r = rows[t]
-            # the brick's samples within reach of the triangle's box, per axis
+            # the brick's samples within reach of the triangle's box, per axis, and
+            # their gaps to it along the axis
             f0, l0 = _local_range(r[0], r[3], cx, o0, margin[0])
+            if f0 > l0:
+                continue
             f1, l1 = _local_range(r[1], r[4], cy, o1, margin[1])
+            if f1 > l1:
+                continue
             f2, l2 = _local_range(r[2], r[5], cz, o2, margin[2])
-            for i2 in range(f2, l2 + 1):
-                sides[i2] = _side(r, 2, cz[o2 + i2], w2, euclidean)
+            if f2 > l2:
+                continue
+            for i in range(f0, l0 + 1):
+                s0[i] = _side(r, 0, cx[o0 + i], w0, euclidean)
+            for i in range(f1, l1 + 1):
+                s1[i] = _side(r, 1, cy[o1 + i], w1, euclidean)
+            for i in range(f2, l2 + 1):
+                s2[i] = _side(r, 2, cz[o2 + i], w2, euclidean)
             for i0 in range(f0, l0 + 1):
                 p0 = cx[o0 + i0]
-                g0 = _side(r, 0, p0, w0, euclidean)
                 for i1 in range(f1, l1 + 1):
                     p1 = cy[o1 + i1]
-                    g1 = _side(r, 1, p1, w1, euclidean)
-                    g1 = g0 + g1 if euclidean else max(g0, g1)
-                    row = out[i0, i1]
+                    g1 = s0[i0] + s1[i1] if euclidean else max(s0[i0], s1[i1])
                     for i2 in range(f2, l2 + 1):
-                        best = row[i2]
+                        best = out[i0, i1, i2]
                         if best <= 0.0:                 # nothing nearer, or not a sample
                             continue
                         if euclidean:
                             limit = best * keep
-                            if g1 + sides[i2] > limit * limit:
+                            if g1 + s2[i2] > limit * limit:
                                 continue
                             d = triangle_euclidean(p0, p1, cz[o2 + i2], tri[t])
                         else:
-                            box = max(g1, sides[i2])    # box_gap's float
+                            box = max(g1, s2[i2])       # box_gap's float
                             if box >= best:
                                 continue
                             d = linf_below(p0, p1, cz[o2 + i2], w0, w1, w2, r, box, best)
                         if d < best:
-                            row[i2] = d
+                            out[i0, i1, i2] = d
         if bounded:
             _start_bounds(out, steps[b], unit, -1.0)
 
@@ -168,5 +178,16 @@ def _start_bounds(out, steps, unit, way):
 
 @njit(**COMPILE)
 def _local_range(lo, hi, centres, o, margin):
-    """:func:`centre_range` among the brick's samples ``o .. o + 7`` (offsets)."""
-    return centre_range(lo, hi, centres[o:o + BRICK], margin)
+    """:func:`centre_range` among the brick's samples ``o .. o + 7`` (offsets): the first
+    and last whose centres lie within ``margin`` of ``[lo, hi]`` (a scan of at most
+    eight; none when ``first > last``)."""
+    n = min(BRICK, centres.size - o)
+    below = lo - margin
+    above = hi + margin
+    first = 0
+    while first < n and centres[o + first] < below:
+        first += 1
+    last = n - 1
+    while last >= first and centres[o + last] > above:
+        last -= 1
+    return first, last
