@@ -32,18 +32,6 @@ def brick_row(keys, i, j, k):
 
 
 @njit(**COMPILE)
-def _least(line, at, band, far):
-    """``min(far, max(|d|, line[at + d]))`` over ``|d| <= band``, nearest offsets first
-    (none farther than the least so far can lower it)."""
-    least = min(far, line[at])
-    for d in range(1, band + 1):
-        if d >= least:
-            break
-        least = min(least, max(d, min(line[at - d], line[at + d])))
-    return least
-
-
-@njit(**COMPILE)
 def band_samples(bricks, candidates, start, voxels, band, shape, steps):
     """The band's samples of each candidate brick into ``steps`` (c, 8, 8, 8): each
     sample's Chebyshev distance, in voxels, to the nearest surface voxel where it is
@@ -59,7 +47,8 @@ def band_samples(bricks, candidates, start, voxels, band, shape, steps):
     far = band + 1
     reach = (band + BRICK - 1) // BRICK
     marks = np.zeros((side, side, side), dtype=np.bool_)
-    along_x = np.empty((BRICK, side, side), dtype=np.int64)
+    along_x = np.empty((BRICK, side, side), dtype=np.int64)        # (x, z, y)
+    plane = np.zeros(side, dtype=np.bool_)                            # z with a mark
     along_y = np.empty((BRICK, BRICK, side), dtype=np.int64)
     lit = np.zeros((side, side), dtype=np.bool_)
     for c in range(candidates.shape[0]):
@@ -83,27 +72,47 @@ def band_samples(bricks, candidates, start, voxels, band, shape, steps):
         steps[c] = far
         if not any_mark:
             continue
-        for y in range(side):                 # along x, on the lines that hold a mark
+        # along x, on the lines that hold a mark: the distance to the nearest mark (two
+        # sweeps), capped at far
+        along_x[:] = far
+        plane[:] = False
+        for y in range(side):
             for z in range(side):
-                for i in range(BRICK):
-                    along_x[i, y, z] = far
                 if not lit[y, z]:
                     continue
-                for i in range(BRICK):
-                    for d in range(band + 1):
-                        if marks[band + i - d, y, z] or marks[band + i + d, y, z]:
-                            along_x[i, y, z] = d
-                            break
-                for x in range(side):
-                    marks[x, y, z] = False
                 lit[y, z] = False
-        for i in range(BRICK):                # along y
+                plane[z] = True
+                last = -side
+                for x in range(BRICK + band):
+                    if marks[x, y, z]:
+                        last = x
+                    if x >= band:
+                        along_x[x - band, z, y] = min(far, x - last)
+                last = 2 * side
+                for x in range(side - 1, band - 1, -1):
+                    if marks[x, y, z]:
+                        last = x
+                        marks[x, y, z] = False
+                    if x < band + BRICK:
+                        along_x[x - band, z, y] = min(along_x[x - band, z, y], last - x)
+                for x in range(band):
+                    marks[x, y, z] = False
+        # along y, then z: min(far, max(|d|, line[at + d])) over |d| <= band
+        for i in range(BRICK):
             for z in range(side):
                 for j in range(BRICK):
-                    along_y[i, j, z] = _least(along_x[i, :, z], band + j, band, far)
+                    least = far
+                    if plane[z]:
+                        for d in range(2 * band + 1):
+                            least = min(least, max(abs(d - band), along_x[i, z, j + d]))
+                    along_y[i, j, z] = least
         for i in range(BRICK):                # along z, inside the grid
             for j in range(BRICK):
                 inside = ci * BRICK + i < shape[0] and cj * BRICK + j < shape[1]
                 for k in range(BRICK):
-                    if inside and ck * BRICK + k < shape[2]:
-                        steps[c, i, j, k] = _least(along_y[i, j], band + k, band, far)
+                    if not (inside and ck * BRICK + k < shape[2]):
+                        continue
+                    least = far
+                    for d in range(2 * band + 1):
+                        least = min(least, max(abs(d - band), along_y[i, j, k + d]))
+                    steps[c, i, j, k] = least
