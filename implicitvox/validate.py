@@ -110,6 +110,18 @@ def choice(value: Any, name: str, options: tuple) -> Any:
     return value
 
 
+def float_type(value: Any, name: str, options: tuple = ("float64", "float32")) -> str:
+    """A float type's name among ``options``, given as a name or a numpy type."""
+    try:
+        shown = np.dtype(value).name if not isinstance(value, str) else value
+    except TypeError:
+        shown = None
+    if shown not in options:
+        raise ValueError(f"{name} must be one of {', '.join(map(repr, options))}, "
+                         f"got {_shown(value)}")
+    return shown
+
+
 #: the least extent bounds may have on an axis: voxels of 2**-21 of it are normal floats
 MIN_EXTENT = float(np.finfo(np.float64).tiny) * 2.0 ** 21
 

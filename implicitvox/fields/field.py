@@ -34,11 +34,40 @@ from ..octree.grid import Grid
 from ..octree.voxels import DEFAULT_DENSE_LIMIT, Voxels
 from .bricks import BRICK, BrickIndex, brick_coords, masked_coords
 
-__all__ = ["DistanceField", "OUTPUTS", "NORMS"]
+__all__ = ["DistanceField", "OUTPUTS", "NORMS", "DTYPES", "stored"]
 
 NORMS = ("euclidean", "linf")
+#: the float types a field stores its values and error bounds in
+DTYPES = ("float64", "float32")
 #: writers behind :meth:`DistanceField.save`, registered by :mod:`implicitvox.io.files`
 OUTPUTS: dict[str, Callable[..., Any]] = {}
+
+
+def stored(values: np.ndarray, errors: np.ndarray, dtype: str
+           ) -> tuple[np.ndarray, np.ndarray]:
+    """Distances and their error bounds (float64) as a field of ``dtype`` stores them.
+
+    float64 keeps them. float32 rounds each value to nearest and adds the rounding,
+    ``|stored - value|`` (exact in float64: the two are that close), to its bound,
+    the sum rounded up (past float64's rounding where both terms are nonzero, then
+    to float32), so that ``|stored - true| <= stored error`` still holds.
+
+    >>> v, e = stored(np.array([0.1, -2.0]), np.array([0.0, 1e-3]), "float32")
+    >>> v.dtype.name, bool(e[0] >= abs(0.1 - float(v[0])) > 0), float(e[1]) > 1e-3
+    ('float32', True, True)
+    """
+    if dtype == "float64":
+        return values, errors
+    small = values.astype(np.float32)
+    with np.errstate(invalid="ignore"):            # NaN beyond the grid, inf never
+        off = np.abs(small.astype(np.float64) - values)
+    total = errors + off
+    summed = (errors > 0) & (off > 0)              # else one term is 0: the sum is exact
+    total[summed] = np.nextafter(total[summed], np.inf)
+    bound = total.astype(np.float32)
+    low = bound < total
+    bound[low] = np.nextafter(bound[low], np.float32(np.inf))
+    return small, bound
 
 
 class DistanceField:
@@ -59,7 +88,8 @@ class DistanceField:
         Sorted Morton codes of the bricks' indices.
     values, errors : ndarray (k, 8, 8, 8)
         Distances and their error bounds (``|value - true| <= error``; 0 for
-        the background samples, whose value is a clamp, not a distance).
+        the background samples, whose value is a clamp, not a distance), float64
+        or float32 (each bound then holds the rounding to float32 too: :func:`stored`).
     active : ndarray of bool (k, 8, 8, 8)
         The band's samples.
     kind : str
@@ -189,18 +219,19 @@ class DistanceField:
 
     # -- dense outputs ------------------------------------------------------------------
     def to_dense(self, max_memory: int = DEFAULT_DENSE_LIMIT) -> np.ndarray:
-        """The field on the whole grid (float64), background beyond the band.
+        """The field on the whole grid (in the field's float type), background beyond
+        the band.
 
         Raises
         ------
         MemoryError
             If the array would need more than ``max_memory`` bytes.
         """
-        need = 8 * int(np.prod(self.grid.shape, dtype=np.float64))
+        need = self.values.itemsize * int(np.prod(self.grid.shape, dtype=np.float64))
         if need > max_memory:
             raise MemoryError(f"a dense {self.grid.shape} distance field needs "
                               f"{size_text(need)}, over max_memory={size_text(max_memory)}")
-        dense = np.full(self.grid.shape, self.background)
+        dense = np.full(self.grid.shape, self.background, dtype=self.values.dtype)
         if self.voxels is not None:
             solid = self.voxels.to_dense(interior=True, max_memory=max_memory)
             dense[solid] = -self.background
@@ -238,7 +269,7 @@ class DistanceField:
                              origin=tuple(o + h / 2 for o, h in zip(self.grid.origin,
                                                                      self.grid.voxel_size)))
         dense = self.to_dense(max_memory)
-        errors = np.zeros(self.grid.shape, dtype=np.float64)
+        errors = np.zeros(self.grid.shape, dtype=self.errors.dtype)
         band = np.zeros(self.grid.shape, dtype=np.uint8)
         c, _, e = self.band_values()
         errors[c[:, 0], c[:, 1], c[:, 2]] = e

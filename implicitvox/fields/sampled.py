@@ -35,22 +35,23 @@ from ..voxelizers.implicit import voxelize
 from ..voxelizers.mesh import voxelize_mesh
 from .bricks import BRICK, MAX_BAND, all_bricks, band_steps, in_grid, masked_coords
 from .band_chunks import DistanceKernel, band_distances, mesh_band_distances
-from .field import NORMS, DistanceField
+from .field import DTYPES, NORMS, DistanceField, stored
 from .suitability import CRITICAL_RADIUS, SUITABILITY_CHECK_LIMIT, is_suitable_at, solid_voxels
 
 __all__ = ["distance_field", "TOLERANCE", "estimate_bytes"]
 
 #: default error target of certified samples, in voxels
 TOLERANCE = 1e-3
-#: bytes per brick sample: value, error, band flag, and the working copies
-_BYTES_PER_SAMPLE = 8 + 8 + 1 + 48
+#: bytes per brick sample beside its value and error: the band flag, and the working
+#: copies (float64)
+_BYTES_PER_SAMPLE = 1 + 48
 #: voxels the certified search first looks within, for a field everywhere
 _FIRST_REACH = 5
 
 
-def estimate_bytes(bricks: int) -> int:
-    """Peak bytes of a field of ``bricks`` bricks."""
-    return bricks * BRICK ** 3 * _BYTES_PER_SAMPLE
+def estimate_bytes(bricks: int, dtype: str = "float64") -> int:
+    """Peak bytes of a field of ``bricks`` bricks stored in ``dtype``."""
+    return bricks * BRICK ** 3 * (_BYTES_PER_SAMPLE + 2 * np.dtype(dtype).itemsize)
 
 
 def _as_mesh(shape: Any) -> Optional[TriangleMesh]:
@@ -68,7 +69,7 @@ def distance_field(shape: Any, resolution: Union[int, tuple[int, int, int], None
                    voxel_size: Union[float, tuple[float, float, float], None] = None,
                    norm: str = "euclidean", band: Optional[int] = 4,
                    tolerance: Optional[float] = None,
-                   check_suitability: bool = True,
+                   check_suitability: bool = True, dtype: str = "float64",
                    progress: Optional[Callable[[float], Any]] = None,
                    max_memory: Optional[int] = None, workers: Optional[int] = None,
                    executor: Any = None) -> DistanceField:
@@ -105,6 +106,11 @@ def distance_field(shape: Any, resolution: Union[int, tuple[int, int, int], None
         grid itself, and warn when it fails; grids over
         :data:`~implicitvox.fields.suitability.SUITABILITY_CHECK_LIMIT` voxels and
         meshes are not tested (``metadata["suitable"]`` is then None).
+    dtype : {"float64", "float32"}, default: "float64"
+        The float type the field stores (half the memory and file size in
+        float32). Each error bound then includes the value's rounding to
+        float32 (at most 2⁻²⁴ of it; :func:`implicitvox.fields.field.stored`), so
+        ``|value - true| <= error`` still holds and ``max_error`` says so.
     progress : callable, optional
         Called with the share of the work done (0 to 1).
     max_memory : int, optional
@@ -132,6 +138,7 @@ def distance_field(shape: Any, resolution: Union[int, tuple[int, int, int], None
         reconstructed near those places are off (Bærentzen §4-§6).
     """
     norm = validate.choice(norm, "norm", NORMS)
+    dtype = validate.float_type(dtype, "dtype", DTYPES)
     run = Run.of(max_memory=max_memory, progress=progress, workers=workers, executor=executor)
     band = None if band is None else validate.int_in(band, "band", 1, MAX_BAND)
     mesh = _as_mesh(shape)
@@ -168,7 +175,7 @@ def distance_field(shape: Any, resolution: Union[int, tuple[int, int, int], None
     else:
         keys, steps = band_steps(surface, band, grid.shape)
         active = steps <= band
-    run.refuse(estimate_bytes(len(keys)),
+    run.refuse(estimate_bytes(len(keys), dtype),
                f"a distance field of {len(keys):,} bricks at {grid.shape}")
     # where the certified search looks first (it widens where no zero is proved)
     reach = _FIRST_REACH if band is None else band + 1
@@ -186,7 +193,8 @@ def distance_field(shape: Any, resolution: Union[int, tuple[int, int, int], None
         values_band, errors_band, used = band_distances(spec, grid, weights,
                                                         masked_coords(keys, active),
                                                         run.part(0.2, 1.0))
-    field = _assemble(grid, norm, band, keys, active, values_band, errors_band, kernel.kind, vox)
+    field = _assemble(grid, norm, band, keys, active, values_band, errors_band, kernel.kind, vox,
+                      dtype)
     field.signed = mesh is None or mesh.closed
     field.metadata["suitable"] = _check_suitability(target, vox) if check_suitability and \
         mesh is None else None
@@ -226,15 +234,14 @@ def _surface_boxes(vox) -> tuple[np.ndarray, np.ndarray]:
     return np.stack(lo, axis=1), np.stack(hi, axis=1)
 
 
-def _assemble(grid, norm, band, keys, active, values_band, errors_band, kind, vox
+def _assemble(grid, norm, band, keys, active, values_band, errors_band, kind, vox, dtype
               ) -> DistanceField:
-    """The bricks: band samples from the kernel, the rest the signed background (NaN
-    beyond the grid)."""
-    field = DistanceField(grid, norm, band, keys, np.empty(active.shape), np.zeros(active.shape),
-                          active, kind, voxels=vox)
+    """The bricks in ``dtype``: band samples from the kernel (:func:`stored`), the rest
+    the signed background (NaN beyond the grid)."""
+    field = DistanceField(grid, norm, band, keys, np.empty(active.shape, dtype=dtype),
+                          np.zeros(active.shape, dtype=dtype), active, kind, voxels=vox)
     values = field.values
-    values[active] = values_band
-    field.errors[active] = errors_band
+    values[active], field.errors[active] = stored(values_band, errors_band, dtype)
     inside = in_grid(keys, grid.shape)
     values[~inside] = np.nan
     rest = inside & ~active

@@ -46,6 +46,7 @@ from ..octree.subdivide import RECHECK
 from ..voxelizers.implicit import voxelize
 from ..voxelizers.mesh import voxelize_mesh
 from ..meshing.mesher import REFINE, mesh
+from ..fields.field import DTYPES
 from ..fields.sampled import distance_field
 from ..fields.suitability import suitability
 from .files import MESH_FORMATS, save_mesh
@@ -222,6 +223,9 @@ def _parser() -> argparse.ArgumentParser:
                      help="voxels around the surface (default 4; 0: every voxel)")
     fld.add_argument("--tolerance", type=float, metavar="E",
                      help="error target of certified distances (default 1e-3 voxel)")
+    fld.add_argument("--dtype", choices=DTYPES, default="float64",
+                     help="the float type stored (float32: half the size; each error bound "
+                          "then includes the rounding)")
     _facets_option(fld)
     fld.add_argument("--out", help="write .npz (lossless) or .vti")
     fld.add_argument("--render", metavar="PNG", help="render the 0-isosurface")
@@ -374,7 +378,8 @@ def _field(args: argparse.Namespace) -> int:
         field = distance_field(shape, args.resolution, bounds=bounds,
                                voxel_size=args.voxel_size, norm=args.norm,
                                band=args.band or None, tolerance=args.tolerance,
-                               progress=bar, max_memory=max_memory, **parallel)
+                               dtype=args.dtype, progress=bar, max_memory=max_memory,
+                               **parallel)
     if bar:
         bar.close()
     h = min(field.grid.voxel_size)

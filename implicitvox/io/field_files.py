@@ -1,6 +1,7 @@
 """Distance-field files: ``.npz`` (the bricks, lossless, read back by
 :func:`load_field`) and ``.vti`` (dense VTK image data for ParaView: point
-arrays ``distance``, ``error`` and ``band``).
+arrays ``distance``, ``error`` and ``band``), in the field's float type
+(float64 or float32).
 
 Examples
 --------
@@ -21,7 +22,7 @@ import numpy as np
 
 from .. import validate
 from ..fields.bricks import BRICK, MAX_BAND
-from ..fields.field import NORMS, DistanceField
+from ..fields.field import DTYPES, NORMS, DistanceField
 from ..octree.grid import MAX_RESOLUTION, Grid
 from .files import check_unpacked
 
@@ -104,7 +105,10 @@ def load_field(path: str) -> DistanceField:
     if keys.dtype != np.uint64 or keys.ndim != 1 or np.any(keys[1:] <= keys[:-1]):
         raise bad("keys", "must be strictly increasing uint64 Morton codes")
     k = len(keys)
-    for name, dtype in (("values", np.float64), ("errors", np.float64), ("active", np.bool_)):
+    stored = arrays["values"].dtype
+    if stored.name not in DTYPES:
+        raise bad("values", f"must be one of {DTYPES}, got {stored.name}")
+    for name, dtype in (("values", stored), ("errors", stored), ("active", np.bool_)):
         if arrays[name].dtype != dtype or arrays[name].shape != (k, BRICK, BRICK, BRICK):
             raise bad(name, f"must be {np.dtype(dtype).name} of shape ({k}, 8, 8, 8)")
     grid = Grid(tuple(origin.tolist()), tuple(size.tolist()), tuple(int(n) for n in shape))

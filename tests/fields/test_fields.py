@@ -285,6 +285,35 @@ def test_suitability_takes_the_finest_grid_memory_holds(monkeypatch):
     assert s.oversample == 1 and 8.5 <= s.r_open <= 10.5 and "about 1 voxel" in str(s)
 
 
+def test_a_float32_field_keeps_the_truth_within_its_bounds_in_half_the_memory(tmp_path):
+    shape, truth = EXACT_CASES["torus"]
+    wide = iv.distance_field(shape, 32, band=3, check_suitability=False)
+    field = iv.distance_field(shape, 32, band=3, check_suitability=False, dtype=np.float32)
+    p, v, e = _band(field)
+    assert v.dtype == e.dtype == np.float32 and field.kind == "exact"
+    assert np.array_equal(field.active, wide.active)
+    _, v64, e64 = _band(wide)
+    off = np.abs(v.astype(np.float64) - v64)              # the rounding, within the bound
+    assert np.all(off <= e - e64) and np.any(off > 0)
+    assert np.all(e <= 2.0 ** -24 * np.abs(v64) + 1e-300)  # and no more than it
+    # the truth (the analytic formula's own rounding is 1e-12, as for float64 fields)
+    assert np.all(np.abs(v - truth(p)) <= e + 1e-12)
+    assert field.max_error == float(e.max()) > 0
+    assert field.nbytes < 0.55 * wide.nbytes + wide.keys.nbytes + wide.active.nbytes
+    assert field.to_dense().dtype == np.float32
+    back = iv.load_field(field.save(str(tmp_path / "f32.npz")))
+    assert back.values.dtype == np.float32 and np.array_equal(back.errors, field.errors)
+    image = pv.read(field.save(str(tmp_path / "f32.vti")))
+    assert image.point_data["distance"].dtype == np.float32
+    mixed = dict(np.load(tmp_path / "f32.npz"))
+    mixed["errors"] = mixed["errors"].astype(np.float64)
+    np.savez(tmp_path / "mixed.npz", **mixed)
+    with pytest.raises(ValueError, match="field 'errors': must be float32"):
+        iv.load_field(str(tmp_path / "mixed.npz"))
+    with pytest.raises(ValueError, match="dtype must be one of 'float64', 'float32'"):
+        iv.distance_field(shape, 8, dtype="float16")
+
+
 def test_files_round_trip_and_refuse_bad_input(tmp_path):
     field = iv.distance_field(linf.Sphere((0, 0, 0), 1.0), 16, band=1)
     back = iv.load_field(field.save(str(tmp_path / "f.npz")))

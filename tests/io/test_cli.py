@@ -196,3 +196,9 @@ def test_field_command_writes_a_field_and_checks_suitability(tmp_path, capsys):
     assert np.allclose(back.values[back.active], np.linalg.norm(p, axis=1) - 1, atol=1e-12)
     assert main(["field", str(model), "--resolution", "8", "--out", "x.stl"]) == 2
     assert "a distance field is written as one of .npz, .vti" in capsys.readouterr().err
+    assert main(["field", str(model), "--resolution", "24", "--band", "2", "--out", str(out),
+                 "--dtype", "float32", "--quiet"]) == 0
+    small = ivx.load_field(str(out))
+    assert small.values.dtype == np.float32 and np.array_equal(small.active, back.active)
+    assert np.all(np.abs(small.values[small.active] - back.values[back.active])
+                  <= small.errors[small.active])
