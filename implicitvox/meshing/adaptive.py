@@ -69,10 +69,11 @@ from .cell_tapes import CellTapes
 __all__ = ["AdaptiveGrid", "adaptive_grid", "corner_values", "BYTES_PER_CELL",
            "LEAF_LEVELS_UP"]
 
-#: bytes per leaf cell at the peak (measured: 1.9 kB on sin(9θ)sin(18φ) - r at 256):
-#: coordinates, level, 8 corner values, flags, and the
-#: contouring's edges, crossings and quadric sums
-BYTES_PER_CELL = 2048
+#: bytes per leaf cell at the peak: coordinates, level, 8 corner values, flags, and the
+#: contouring's edges, crossings and quadric sums (``bench_mesh_memory.py``: the peak's
+#: growth over the run's start is 885-1,193 bytes per leaf on the seven models at 256
+#: and 512)
+BYTES_PER_CELL = 1280
 #: cells classified per numpy call below the tolerance level
 _CHUNK = 1 << 14
 #: the cells take the pruned tape of their ancestor this many levels above the
