@@ -109,16 +109,9 @@ def child_pairs(triangles, grid, level: int, nodes: np.ndarray, tri: np.ndarray,
     clo = np.empty((8 * m, 3))
     chi = np.empty((8 * m, 3))
     state = np.empty(8 * m, dtype=np.int8)
-    dilated = triangles.dilation is not None
-    dilation = triangles.dilation if dilated else np.zeros((1, 3))
     n = 0
     if m:
-        n = _child_pairs(triangles.v, triangles.lo, triangles.hi, triangles.normal_sign,
-                         triangles.axis, triangles.planes.rows, dilation, dilated,
-                         np.asarray(grid.origin, dtype=np.float64),
-                         np.asarray(grid.voxel_size, dtype=np.float64),
-                         np.asarray(grid.shape, dtype=np.int64),
-                         1 << (grid.depth - level - 1),
+        n = _child_pairs(*_kernel_arguments(triangles, grid), 1 << (grid.depth - level - 1),
                          np.ascontiguousarray(nodes, dtype=np.int64),
                          np.ascontiguousarray(tri, dtype=np.int64), bool(test),
                          child, ctri, clo, chi, state)
@@ -191,14 +184,20 @@ def voxel_pairs(triangles, grid, tri: np.ndarray, first: np.ndarray, last: np.nd
     clo = np.empty((m, 3))
     chi = np.empty((m, 3))
     state = np.empty(m, dtype=np.int8)
-    dilated = triangles.dilation is not None
-    dilation = triangles.dilation if dilated else np.zeros((1, 3))
     n = 0
     if m:
-        n = _voxel_pairs(triangles.v, triangles.lo, triangles.hi, triangles.normal_sign,
-                         triangles.axis, triangles.planes.rows, dilation, dilated,
-                         np.asarray(grid.origin, dtype=np.float64),
-                         np.asarray(grid.voxel_size, dtype=np.float64),
-                         np.asarray(grid.shape, dtype=np.int64), tri, first, last,
-                         codes, ctri, clo, chi, state)
+        n = _voxel_pairs(*_kernel_arguments(triangles, grid), tri, first, last, codes, ctri,
+                         clo, chi, state)
     return codes[:n], ctri[:n], clo[:n], chi[:n], state[:n]
+
+
+def _kernel_arguments(triangles, grid) -> tuple:
+    """The triangles' arrays (with their dilation, zeros where none) and the grid's,
+    as the kernels take them first."""
+    dilated = triangles.dilation is not None
+    dilation = triangles.dilation if dilated else np.zeros((1, 3))
+    return (triangles.v, triangles.lo, triangles.hi, triangles.normal_sign, triangles.axis,
+            triangles.planes.rows, dilation, dilated,
+            np.asarray(grid.origin, dtype=np.float64),
+            np.asarray(grid.voxel_size, dtype=np.float64),
+            np.asarray(grid.shape, dtype=np.int64))
