@@ -46,7 +46,7 @@ from .tribox import Triangles
 from .. import batches
 from ..parallel import PIECES_PER_WORKER, Job, farm
 
-__all__ = ["surface_codes", "start_pairs", "run_pairs", "split_pairs", "PairsJob",
+__all__ = ["surface_codes", "start_pairs", "small_codes", "run_pairs", "split_pairs", "PairsJob",
            "sorted_unique", "CHUNK", "SMALL_VOXELS", "SMALL_TESTS"]
 
 #: (node, triangle) pairs per chunk
@@ -166,23 +166,27 @@ def surface_codes(tris: Triangles, grid: Grid,
     """Sorted unique Morton codes of the voxels whose closed boxes meet a triangle.
 
     With ``workers`` > 1 or an ``executor``, the pairs are cut into subtrees
-    (:func:`split_pairs`) and farmed out (:class:`PairsJob`); each subtree's
-    voxels are exactly the serial run's inside it, so the result is the same array.
+    (:func:`split_pairs`), the small triangles into runs of about equal tests, and
+    both farmed out (:class:`PairsJob`); each piece's voxels are exactly the serial
+    run's of it, so the result is the same array.
     """
-    stack, found = start_pairs(tris, grid, progress)
-    if workers > 1 or executor is not None:
-        done = 1.0 - sum(weight for *_, weight in stack)
-        level, pieces = split_pairs(tris, grid, stack, PIECES_PER_WORKER * workers)
+    parallel = (workers > 1 or executor is not None) and grid.depth >= 3
+    deferred: Optional[list] = [] if parallel else None
+    stack, found = start_pairs(tris, grid, None if parallel else progress, small=deferred,
+                               parts=PIECES_PER_WORKER * workers)
+    if deferred is not None:
+        _, pieces = split_pairs(tris, grid, stack, PIECES_PER_WORKER * workers) if stack \
+            else (0, [])
+        stack = []                  # every pair that may meet a voxel is in a piece
+        pieces = pieces + [("voxels",) + chunk for chunk in deferred]
         if pieces:
             job = PairsJob(tris, grid)
-            weights = [sum(len(n) for _, n, _ in piece) for piece in pieces]
-            rest = None if progress is None else \
-                (lambda f: progress(done + (1.0 - done) * f))
+            weights = [sum(len(n) for _, n, _ in piece) if isinstance(piece, list) else
+                       int(np.prod(piece[3] - piece[2] + 1, axis=1).sum()) for piece in pieces]
             for _, codes in farm(job, pieces, workers=workers, executor=executor,
-                                 weights=weights, progress=rest,
+                                 weights=weights, progress=progress,
                                  what=f"voxelizing the mesh at {grid.shape}"):
                 found.append(codes)
-            stack = []
     found.extend(run_pairs(tris, grid, stack, progress))
     if not found:
         return np.zeros(0, dtype=np.uint64)
@@ -190,28 +194,28 @@ def surface_codes(tris: Triangles, grid: Grid,
 
 
 def start_pairs(tris: Triangles, grid: Grid,
-                progress: Optional[Callable[[float], Any]] = None) -> tuple[list, list[np.ndarray]]:
+                progress: Optional[Callable[[float], Any]] = None, *,
+                small: Optional[list] = None, parts: int = 1) -> tuple[list, list[np.ndarray]]:
     """The first pairs of every triangle (:func:`_start_pairs`), tested: a stack of
     ``(level, nodes, tri, weight)`` above the voxels (weights: shares of the
     work, what the small triangles took left out) and the codes of voxels already
-    found (the small triangles' voxels all found here, ``progress`` told)."""
-    from .pair_kernels import voxel_pairs       # (loads Numba: not at import)
-    from .tribox_kernels import settled
-    starts, small = _start_pairs(tris, grid)
+    found: the small triangles' voxels all found here (``progress`` told), or, given
+    a list ``small``, their runs ``(tri, first, last)`` (at least ``parts`` of them
+    where there are enough) appended to it for :func:`small_codes`."""
+    starts, few = _start_pairs(tris, grid)
     total = sum(len(nodes) for _, nodes, _ in starts) or 1
     big = len(np.unique(np.concatenate([t for *_, t in starts]))) if starts else 0
-    share = len(small[0]) / max(len(small[0]) + big, 1)
+    share = 0.0 if small is not None else len(few[0]) / max(len(few[0]) + big, 1)
     stack: list[tuple[int, np.ndarray, np.ndarray, float]] = []
     found: list[np.ndarray] = []
-    tests = np.cumsum(np.prod(small[2] - small[1] + 1, axis=1))
-    cuts = np.unique(np.searchsorted(tests, np.arange(SMALL_TESTS, tests[-1] if len(tests)
-                                                      else 0, SMALL_TESTS), side="right"))
-    for a, b in zip(np.r_[0, cuts], np.r_[cuts, len(tests)] if len(tests) else []):
-        codes, tri, lo, hi, state = voxel_pairs(tris, grid, *(c[a:b] for c in small))
-        found.append(sorted_unique(codes[settled(state, tris.meet_by_arrays, tri, lo, hi)
-                                         == 1]))
+    chunks = _small_chunks(few, parts if small is not None else 1)
+    if small is not None:
+        small.extend(chunks)
+        chunks = []
+    for k, chunk in enumerate(chunks):
+        found.append(small_codes(tris, grid, chunk))
         if progress is not None:
-            progress(share * float(b) / len(tests))
+            progress(share * (k + 1) / len(chunks))
     for level, nodes, tri in starts:
         # the start nodes only share a bounding box with their triangle: test them
         lo, hi = _boxes(grid, level, nodes)
@@ -224,6 +228,30 @@ def start_pairs(tris: Triangles, grid: Grid,
         else:
             _push(stack, level, nodes[holds], tri[holds], weight)
     return stack, found
+
+
+def _small_chunks(few: tuple, parts: int) -> list[tuple[np.ndarray, np.ndarray, np.ndarray]]:
+    """The small triangles ``(tri, first, last)`` in runs of at most :data:`SMALL_TESTS`
+    voxel tests, and at least ``parts`` runs where there are that many triangles."""
+    tests = np.cumsum(np.prod(few[2] - few[1] + 1, axis=1))
+    if not len(tests):
+        return []
+    step = max(1, min(SMALL_TESTS, int(tests[-1]) // max(parts, 1)))
+    cuts = np.unique(np.searchsorted(tests, np.arange(step, tests[-1], step), side="right"))
+    return [tuple(c[a:b] for c in few) for a, b in zip(np.r_[0, cuts], np.r_[cuts, len(tests)])
+            if b > a]
+
+
+def small_codes(tris: Triangles, grid: Grid,
+                chunk: tuple[np.ndarray, np.ndarray, np.ndarray]) -> np.ndarray:
+    """Sorted codes of the voxels that the small triangles of ``chunk`` (``tri, first,
+    last``: their voxel ranges) meet, each voxel tested directly
+    (:func:`implicitvox.triangles.pair_kernels.voxel_pairs`, the unsure pairs settled
+    on the exact path)."""
+    from .pair_kernels import voxel_pairs       # (loads Numba: not at import)
+    from .tribox_kernels import settled
+    codes, tri, lo, hi, state = voxel_pairs(tris, grid, *chunk)
+    return sorted_unique(codes[settled(state, tris.meet_by_arrays, tri, lo, hi) == 1])
 
 
 def run_pairs(tris: Triangles, grid: Grid, stack: list,
@@ -300,9 +328,12 @@ class PairsJob(Job):
         super().__init__()
         self.tris, self.grid = tris, grid
 
-    def run(self, piece: list) -> np.ndarray:
-        """The sorted codes of the voxels met in the subtrees of ``piece``
-        (a list of ``(level, nodes, tri)``)."""
+    def run(self, piece: Any) -> np.ndarray:
+        """The sorted codes of the voxels met in the subtrees of ``piece`` (a list of
+        ``(level, nodes, tri)``), or by its small triangles (``("voxels", tri, first,
+        last)``: :func:`small_codes`)."""
+        if isinstance(piece, tuple):
+            return small_codes(self.tris, self.grid, piece[1:])
         stack: list = []
         for level, nodes, t in piece:
             _push(stack, level, nodes, t, 0.0)
