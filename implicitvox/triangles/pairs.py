@@ -178,6 +178,8 @@ def surface_codes(tris: Triangles, grid: Grid,
         _, pieces = split_pairs(tris, grid, stack, PIECES_PER_WORKER * workers) if stack \
             else (0, [])
         stack = []                  # every pair that may meet a voxel is in a piece
+        if deferred:                # the first run here: its kernel is compiled (and cached)
+            found.append(small_codes(tris, grid, deferred.pop(0)))   # before workers need it
         pieces = pieces + [("voxels",) + chunk for chunk in deferred]
         if pieces:
             job = PairsJob(tris, grid)
