@@ -29,8 +29,8 @@ import numpy as np
 
 from ..octree import morton
 
-__all__ = ["BRICK", "band_bricks", "band_steps", "all_bricks", "brick_coords", "masked_coords", "in_grid",
-           "BrickIndex", "MAX_BAND"]
+__all__ = ["BRICK", "band_bricks", "band_steps", "all_bricks", "brick_coords", "masked_coords",
+           "in_grid", "BrickIndex", "MAX_BAND"]
 
 #: samples per brick edge
 BRICK = 8
@@ -82,8 +82,8 @@ def band_steps(surface: np.ndarray, band: int, shape: tuple[int, int, int]
     start = np.append(first, len(codes)).astype(np.int64)
     # the candidates: every brick within the band's reach of a surface brick
     reach = -(-band // BRICK)
-    steps = np.arange(-reach, reach + 1)
-    offsets = np.stack(np.meshgrid(steps, steps, steps, indexing="ij"), -1).reshape(-1, 3)
+    span = np.arange(-reach, reach + 1)
+    offsets = np.stack(np.meshgrid(span, span, span, indexing="ij"), -1).reshape(-1, 3)
     near = (morton.decode(bricks)[:, None, :] + offsets[None]).reshape(-1, 3)
     near = near[np.all((near >= 0) & (near < -(-np.asarray(shape) // BRICK)), axis=1)]
     keys = np.unique(morton.encode(near))

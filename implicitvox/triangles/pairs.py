@@ -206,8 +206,10 @@ def start_pairs(tris: Triangles, grid: Grid,
     where there are enough) appended to it for :func:`small_codes`."""
     starts, few = _start_pairs(tris, grid)
     total = sum(len(nodes) for _, nodes, _ in starts) or 1
-    big = len(np.unique(np.concatenate([t for *_, t in starts]))) if starts else 0
-    share = 0.0 if small is not None else len(few[0]) / max(len(few[0]) + big, 1)
+    share = 0.0                     # of the progress, the small triangles' (run here)
+    if small is None and len(few[0]):
+        big = len(np.unique(np.concatenate([t for *_, t in starts]))) if starts else 0
+        share = len(few[0]) / (len(few[0]) + big)
     stack: list[tuple[int, np.ndarray, np.ndarray, float]] = []
     found: list[np.ndarray] = []
     chunks = _small_chunks(few, parts if small is not None else 1)
