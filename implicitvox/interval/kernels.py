@@ -97,21 +97,34 @@ def magnitude(lo, hi):
 
 # -- the four operations ------------------------------------------------------
 def i_add(alo, ahi, blo, bhi):
-    return rounding.down(alo + blo), rounding.up(ahi + bhi)
+    """``a + b``; a computed end of 0 is exact and stays (:func:`rounding.down_sum`)."""
+    return rounding.down_sum(alo + blo), rounding.up_sum(ahi + bhi)
 
 
 def i_sub(alo, ahi, blo, bhi):
-    return rounding.down(alo - bhi), rounding.up(ahi - blo)
+    return rounding.down_sum(alo - bhi), rounding.up_sum(ahi - blo)
 
 
 def i_addc(alo, ahi, c: float):
     """``a + c`` for an exact constant ``c`` (``a - c`` is ``a + (-c)``)."""
-    return rounding.down(alo + c), rounding.up(ahi + c)
+    return rounding.down_sum(alo + c), rounding.up_sum(ahi + c)
 
 
 def i_rsubc(alo, ahi, c: float):
     """``c - a`` for an exact constant ``c``."""
-    return rounding.down(c - ahi), rounding.up(c - alo)
+    return rounding.down_sum(c - ahi), rounding.up_sum(c - alo)
+
+
+def _zero(alo, ahi):
+    """Where ``[alo, ahi]`` is exactly 0: a product or quotient with it is exactly 0."""
+    return (np.asanyarray(alo) == 0.0) & (np.asanyarray(ahi) == 0.0)
+
+
+def _exact_zeros(lo, hi, zero):
+    """``lo, hi`` with 0 where ``zero`` (a product or quotient of an exact 0)."""
+    if np.any(zero):
+        lo, hi = np.where(zero, 0.0, lo), np.where(zero, 0.0, hi)
+    return lo, hi
 
 
 def i_mulc(alo, ahi, c: float):
@@ -124,7 +137,7 @@ def i_mulc(alo, ahi, c: float):
             return np.zeros_like(lo), np.zeros_like(hi)
     else:
         lo, hi = ahi * c, alo * c
-    return rounding.down(lo), rounding.up(hi)
+    return _exact_zeros(rounding.down(lo), rounding.up(hi), _zero(alo, ahi))
 
 
 def i_divc(alo, ahi, c: float):
@@ -132,7 +145,7 @@ def i_divc(alo, ahi, c: float):
     the rounded-outward quotient holds)."""
     with np.errstate(over="ignore"):
         lo, hi = (alo / c, ahi / c) if c > 0.0 else (ahi / c, alo / c)
-    return rounding.down(lo), rounding.up(hi)
+    return _exact_zeros(rounding.down(lo), rounding.up(hi), _zero(alo, ahi))
 
 
 def i_neg(alo, ahi):
@@ -149,17 +162,17 @@ def _hull4(p1, p2, p3, p4):
 def i_mul(alo, ahi, blo, bhi):
     with np.errstate(invalid="ignore"):
         lo, hi = _hull4(alo * blo, alo * bhi, ahi * blo, ahi * bhi)
-    if np.isnan(lo).any():  # all four corners 0*inf: a = [0, 0], the product is 0
-        lo, hi = np.nan_to_num(lo, nan=0.0), np.nan_to_num(hi, nan=0.0)
-    return rounding.down(lo), rounding.up(hi)
+    # an exact 0 operand (all four corners 0 * inf too): the product is exactly 0
+    return _exact_zeros(rounding.down(lo), rounding.up(hi), _zero(alo, ahi) | _zero(blo, bhi))
 
 
 def i_div(alo, ahi, blo, bhi):
     with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
         lo, hi = _hull4(alo / blo, alo / bhi, ahi / blo, ahi / bhi)
     holds_zero = (blo <= 0.0) & (bhi >= 0.0)
-    lo = np.where(holds_zero, -INF, rounding.down(lo))
-    hi = np.where(holds_zero, INF, rounding.up(hi))
+    lo, hi = _exact_zeros(rounding.down(lo), rounding.up(hi), _zero(alo, ahi))
+    lo = np.where(holds_zero, -INF, lo)
+    hi = np.where(holds_zero, INF, hi)
     return lo, hi
 
 

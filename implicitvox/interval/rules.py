@@ -48,7 +48,7 @@ from numba import njit
 from .rounding import COS_ULPS, EPS, LIMITS, POW_ULPS, SIN_ULPS, TRANSCENDENTAL_ULPS
 
 __all__ = [
-    "down", "up", "down_nonneg", "up_nonneg",
+    "down", "up", "down_nonneg", "up_nonneg", "down_sum", "up_sum",
     "i_add", "i_sub", "i_mul", "i_div", "i_neg", "i_addc", "i_rsubc", "i_mulc", "i_divc",
     "i_square", "i_powi", "i_powr", "i_sqrt", "i_abs", "i_exp", "i_log", "i_sin", "i_cos",
     "i_tan", "i_atan", "i_asin", "i_acos", "i_atan2", "i_hypot", "i_min", "i_max", "i_floor",
@@ -169,28 +169,45 @@ def magnitude(lo, hi):
 
 # -- the four operations ------------------------------------------------------------------
 @njit(**COMPILE)
+def down_sum(a):
+    """rounding.down_sum: :func:`down` by one float, but a computed sum of 0 stays."""
+    return a if a == 0.0 else down(a, 1)
+
+
+@njit(**COMPILE)
+def up_sum(a):
+    """rounding.up_sum: :func:`up` by one float, but a computed sum of 0 stays."""
+    return a if a == 0.0 else up(a, 1)
+
+
+@njit(**COMPILE)
 def i_add(alo, ahi, blo, bhi):
-    return down(alo + blo, 1), up(ahi + bhi, 1)
+    return down_sum(alo + blo), up_sum(ahi + bhi)
 
 
 @njit(**COMPILE)
 def i_sub(alo, ahi, blo, bhi):
-    return down(alo - bhi, 1), up(ahi - blo, 1)
+    return down_sum(alo - bhi), up_sum(ahi - blo)
 
 
 @njit(**COMPILE)
 def i_addc(alo, ahi, c):
-    return down(alo + c, 1), up(ahi + c, 1)
+    return down_sum(alo + c), up_sum(ahi + c)
 
 
 @njit(**COMPILE)
 def i_rsubc(alo, ahi, c):
-    return down(c - ahi, 1), up(c - alo, 1)
+    return down_sum(c - ahi), up_sum(c - alo)
+
+
+@njit(**COMPILE)
+def _is_zero(alo, ahi):
+    return alo == 0.0 and ahi == 0.0
 
 
 @njit(**COMPILE)
 def i_mulc(alo, ahi, c):
-    if c == 0.0:       # 0 * inf
+    if c == 0.0 or _is_zero(alo, ahi):       # exactly 0 (0 * inf too)
         return 0.0, 0.0
     if c > 0.0:
         return down(alo * c, 1), up(ahi * c, 1)
@@ -199,6 +216,8 @@ def i_mulc(alo, ahi, c):
 
 @njit(**COMPILE)
 def i_divc(alo, ahi, c):
+    if _is_zero(alo, ahi):
+        return 0.0, 0.0
     if c > 0.0:
         return down(alo / c, 1), up(ahi / c, 1)
     return down(ahi / c, 1), up(alo / c, 1)
@@ -211,11 +230,11 @@ def i_neg(alo, ahi):
 
 @njit(**COMPILE)
 def i_mul(alo, ahi, blo, bhi):
+    if _is_zero(alo, ahi) or _is_zero(blo, bhi):      # exactly 0 (0 * inf too)
+        return 0.0, 0.0
     p1, p2, p3, p4 = alo * blo, alo * bhi, ahi * blo, ahi * bhi
     lo = _fmin(_fmin(p1, p2), _fmin(p3, p4))
     hi = _fmax(_fmax(p1, p2), _fmax(p3, p4))
-    if lo != lo:       # all four corners 0 * inf: a = [0, 0], the product is 0
-        lo, hi = 0.0, 0.0
     return down(lo, 1), up(hi, 1)
 
 
@@ -223,6 +242,8 @@ def i_mul(alo, ahi, blo, bhi):
 def i_div(alo, ahi, blo, bhi):
     if blo <= 0.0 <= bhi:
         return -INF, INF
+    if _is_zero(alo, ahi):
+        return 0.0, 0.0
     p1, p2, p3, p4 = alo / blo, alo / bhi, ahi / blo, ahi / bhi
     lo = _fmin(_fmin(p1, p2), _fmin(p3, p4))
     hi = _fmax(_fmax(p1, p2), _fmax(p3, p4))

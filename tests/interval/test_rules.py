@@ -204,3 +204,31 @@ def test_a_read_only_install_compiles_in_memory(tmp_path):
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                           cwd=tmp_path, env=env, timeout=300)
     assert done.returncode == 0 and done.stdout.strip() == "ok", done.stderr[-2000:]
+
+
+def test_exact_zeros_stay_exact_in_both_kernels():
+    """A sum that rounds to 0 is exact, and so is a product or quotient with an exact
+    [0, 0]: both kernels keep them 0 (else they grow to subnormal widths, which
+    compiled code pays about a hundred cycles per operation for), and a gradient
+    component the function does not depend on stays exactly [0, 0]."""
+    from implicitvox.eval.mean_value_kernels import tape_interval_gradients
+    from implicitvox.interval import kernels, rules
+    inf = np.inf
+    cases = [("i_add", (0.0, 0.0, 0.0, 0.0)), ("i_sub", (1.5, 1.5, 1.5, 1.5)),
+             ("i_mul", (0.0, 0.0, -inf, 5.0)), ("i_mul", (-2.0, 3.0, 0.0, 0.0)),
+             ("i_div", (0.0, 0.0, 1.0, 2.0)), ("i_mulc", (0.0, 0.0, -3.0)),
+             ("i_divc", (0.0, 0.0, 7.0)), ("i_addc", (-0.5, 2.0, 0.5))]
+    for name, args in cases:
+        for module in (rules, kernels):
+            lo, hi = getattr(module, name)(*args)
+            assert float(lo) == 0.0 and float(hi if name != "i_addc" else lo) == 0.0, \
+                (name, module.__name__, lo, hi)
+    # a quotient by an interval holding 0 is still everything
+    assert rules.i_div(0.0, 0.0, -1.0, 1.0) == (-inf, inf)
+    # non-zero sums are still widened
+    assert rules.i_add(1.0, 1.0, 2.0, 2.0)[0] < 3.0
+    from implicitvox import x, y
+    tape = build_tape(x * y * ivx.sin(x) + ivx.exp(y))
+    lo = np.array([[0.1, -1.0], [0.2, 0.5], [0.0, 0.0]])
+    _, _, glo, ghi, _ = tape_interval_gradients(tape, lo, lo + 0.01, libm=True)
+    assert np.all(glo[2] == 0.0) and np.all(ghi[2] == 0.0)
