@@ -20,7 +20,7 @@ Euclidean or the (weighted) max-norm, by branch and bound over boxes:
   distance to box ∩ slab is computed exactly in both norms (a projection onto
   a box and a hyperplane; a cube growing into it); the slab is thin to second
   order in the box size, so near the contact few boxes survive at each level,
-  and they are split until ``U - L`` is below the tolerance (Varadhan §4.3
+  and they are split until ``(U - L) / 2`` is below the tolerance (Varadhan §4.3
   refines a hardware estimate by local optimization; this refines by
   intervals, so the result is proved).
 
@@ -262,7 +262,8 @@ def certified_distances(func: Function, points: np.ndarray, norm: str, weights: 
         again 4 times farther, up to the boxes' whole extent. A point with no
         surface anywhere in the boxes gets ``inf``.
     tolerance : float
-        Stop refining a point when ``U - L <= tolerance``.
+        Stop refining a point when its error bound, ``(U - L) / 2`` moved outward,
+        is at most ``tolerance``.
     stats : dict, optional
         Receives counts: ``"pairs"`` (point-box pairs evaluated) and ``"capped"``
         (points left above the tolerance when their pairs outgrew :data:`MAX_PAIRS`).
@@ -294,6 +295,10 @@ def certified_distances(func: Function, points: np.ndarray, norm: str, weights: 
         if len(boxes_lo) else np.zeros(3)
     max_reach = max(limit, float(np.max(span / (1.0 if euclidean else np.min(w)))) * 2.0)
     sign = _point_signs(ev, p)
+    # the gap U - L at which a point's error, with _bracket's outward margins (at
+    # most _MARGIN (L + 1 + |p|)), is within the tolerance
+    gap = 2.0 * tolerance - _MARGIN * (max_reach + 1.0 + float(np.max(np.abs(p))))
+    gap = max(gap, tolerance)
     stats = {} if stats is None else stats
     stats.setdefault("pairs", 0)
     stats.setdefault("capped", 0)
@@ -302,7 +307,7 @@ def certified_distances(func: Function, points: np.ndarray, norm: str, weights: 
         reach = limit
         while len(rows):
             lo_b, up_b = _bracket(ev, euclidean, p[rows], w[rows], tree, boxes_lo, boxes_hi,
-                                  half_diag, scale, reach, tolerance, max_levels, stats)
+                                  half_diag, scale, reach, gap, max_levels, stats)
             value[rows] = 0.5 * (lo_b + up_b)
             error[rows] = 0.5 * (up_b - lo_b)
             # no zero proved within reach: search farther (all the boxes at the end)
@@ -327,7 +332,7 @@ def _point_signs(ev: _Enclosures, p: np.ndarray) -> np.ndarray:
 
 
 def _bracket(ev, euclidean, p, w, tree, boxes_lo, boxes_hi, half_diag, scale, limit,
-             tolerance, max_levels, stats):
+             gap, max_levels, stats):
     """``(L, U)`` for one block of points (see the module docstring)."""
     n = len(p)
     if tree is None:                    # no box may hold the surface: none within reach
@@ -353,7 +358,7 @@ def _bracket(ev, euclidean, p, w, tree, boxes_lo, boxes_hi, half_diag, scale, li
         used, box = np.unique(box, return_inverse=True)
         pt = np.repeat(rows, counts[rows])
         _refine(ev, euclidean, p, w, pt, box.reshape(-1), np.ascontiguousarray(boxes_lo[used].T),
-                np.ascontiguousarray(boxes_hi[used].T), 0, state, limit, tolerance, max_levels,
+                np.ascontiguousarray(boxes_hi[used].T), 0, state, limit, gap, max_levels,
                 stats)
     lower, upper = state["lower"], state["upper"]
     # outward: a relative margin, and one for the roundings of coordinates of this size
@@ -361,7 +366,7 @@ def _bracket(ev, euclidean, p, w, tree, boxes_lo, boxes_hi, half_diag, scale, li
     return np.maximum(lower * (1 - _MARGIN) - slack, 0.0), upper
 
 
-def _refine(ev, euclidean, p, w, pt, box, lo, hi, level, state, limit, tolerance, max_levels,
+def _refine(ev, euclidean, p, w, pt, box, lo, hi, level, state, limit, gap, max_levels,
             stats, parent=None):
     """Bound, prune and split the pairs ``(pt, box)`` level by level (``pt`` sorted;
     ``box`` indexes the boxes ``lo, hi`` (3, m) of this level, each evaluated once;
@@ -416,10 +421,10 @@ def _refine(ev, euclidean, p, w, pt, box, lo, hi, level, state, limit, tolerance
         pt, box, lb = pt[keep], box[keep], lb[keep]
         least = np.minimum(np.minimum(best[mine], parked[mine]), reach[mine])
         lower[mine] = np.where(open_[mine], least, lower[mine])
-        open_[mine] &= reach[mine] - lower[mine] > tolerance
-        # a pair whose bound is within the tolerance of the reach needs no splitting:
+        open_[mine] &= reach[mine] - lower[mine] > gap
+        # a pair whose bound is within the gap of the reach needs no splitting:
         # it is parked, its bound kept in the point's lower bound
-        park = lb >= reach[pt] - tolerance
+        park = lb >= reach[pt] - gap
         np.minimum.at(parked, pt[park], lb[park])
         still = open_[pt] & ~park
         pt, box = pt[still], box[still]
@@ -437,7 +442,7 @@ def _refine(ev, euclidean, p, w, pt, box, lo, hi, level, state, limit, tolerance
             first = pt < points[len(points) // 2]
             for half in (first, ~first):
                 _refine(ev, euclidean, p, w, pt[half], box[half], lo, hi, level, state, limit,
-                        tolerance, max_levels, stats, parent)
+                        gap, max_levels, stats, parent)
             return
 
 
