@@ -48,7 +48,6 @@ True
 """
 from __future__ import annotations
 
-import itertools
 from typing import Any, Callable, Optional
 
 import numpy as np
@@ -274,7 +273,6 @@ def certified_distances(func: Function, points: np.ndarray, norm: str, weights: 
         ``|value - d| <= error`` for the true signed distance ``d`` to the surface
         held in the boxes.
     """
-    from scipy.spatial import cKDTree
     euclidean = norm == "euclidean"
     p = np.asarray(points, dtype=np.float64)
     n = len(p)
@@ -289,8 +287,10 @@ def certified_distances(func: Function, points: np.ndarray, norm: str, weights: 
     boxes_hi = np.asarray(boxes_hi, dtype=np.float64)
     half_diag = float(np.max(np.linalg.norm(boxes_hi - boxes_lo, axis=1))) / 2 if len(boxes_lo) \
         else 0.0
-    tree = cKDTree(0.5 * (boxes_lo + boxes_hi)) if len(boxes_lo) else None
     scale = float(np.max(boxes_hi - boxes_lo)) if len(boxes_lo) else 1.0
+    # (cells of 4 boxes: the balls reach a few boxes, so a few columns of cells each)
+    centres = ev.kernels.CentreGrid(0.5 * (boxes_lo + boxes_hi), 4.0 * scale) \
+        if len(boxes_lo) else None
     span = np.concatenate([boxes_hi, p]).max(axis=0) - np.concatenate([boxes_lo, p]).min(axis=0) \
         if len(boxes_lo) else np.zeros(3)
     max_reach = max(limit, float(np.max(span / (1.0 if euclidean else np.min(w)))) * 2.0)
@@ -306,7 +306,7 @@ def certified_distances(func: Function, points: np.ndarray, norm: str, weights: 
         rows = np.arange(s, min(s + _BLOCK, n))
         reach = limit
         while len(rows):
-            lo_b, up_b = _bracket(ev, euclidean, p[rows], w[rows], tree, boxes_lo, boxes_hi,
+            lo_b, up_b = _bracket(ev, euclidean, p[rows], w[rows], centres, boxes_lo, boxes_hi,
                                   half_diag, scale, reach, gap, max_levels, stats)
             value[rows] = 0.5 * (lo_b + up_b)
             error[rows] = 0.5 * (up_b - lo_b)
@@ -331,19 +331,18 @@ def _point_signs(ev: _Enclosures, p: np.ndarray) -> np.ndarray:
     return np.where(proved != 0, proved, np.where(v < 0, -1.0, 1.0)).astype(np.float64)
 
 
-def _bracket(ev, euclidean, p, w, tree, boxes_lo, boxes_hi, half_diag, scale, limit,
+def _bracket(ev, euclidean, p, w, centres, boxes_lo, boxes_hi, half_diag, scale, limit,
              gap, max_levels, stats):
     """``(L, U)`` for one block of points (see the module docstring)."""
     n = len(p)
-    if tree is None:                    # no box may hold the surface: none within reach
+    if centres is None:                    # no box may hold the surface: none within reach
         return np.full(n, limit), np.full(n, np.inf)
     upper = _newton_upper(ev, euclidean, p, w, scale)
     # the initial pairs: boxes whose centre is within reach (a superset, then exact),
     # gathered for groups of points with at most MAX_PAIRS pairs between them
     reach = np.minimum(upper, limit)
     euclid_reach = reach * (1.0 if euclidean else np.sqrt(3) * float(np.max(w))) + half_diag
-    counts = np.asarray(tree.query_ball_point(p, euclid_reach, return_length=True),
-                        dtype=np.int64)
+    counts = centres.pairs(p, euclid_reach)
     lower = np.where(counts == 0, reach, 0.0)     # no box within reach: nothing nearer
     state = {"upper": upper, "lower": lower, "open": counts > 0, "parked": np.full(n, np.inf),
              # the domain the boxes cover (their bounding box): a nearest zero inside it
@@ -352,11 +351,9 @@ def _bracket(ev, euclidean, p, w, tree, boxes_lo, boxes_hi, half_diag, scale, li
     group = np.cumsum(counts) // MAX_PAIRS
     for g in np.unique(group[counts > 0]):
         rows = np.flatnonzero((group == g) & (counts > 0))
-        found = tree.query_ball_point(p[rows], euclid_reach[rows])
-        box = np.fromiter(itertools.chain.from_iterable(found), dtype=np.int64,
-                          count=int(counts[rows].sum()))
+        pt, box = centres.pairs(p[rows], euclid_reach[rows], counts[rows])
         used, box = np.unique(box, return_inverse=True)
-        pt = np.repeat(rows, counts[rows])
+        pt = rows[pt]
         _refine(ev, euclidean, p, w, pt, box.reshape(-1), np.ascontiguousarray(boxes_lo[used].T),
                 np.ascontiguousarray(boxes_hi[used].T), 0, state, limit, gap, max_levels,
                 stats)

@@ -35,7 +35,7 @@ from numba import njit
 from ..interval.rules import COMPILE
 
 __all__ = ["box_slabs", "pair_bounds", "settle_pairs", "shell_pairs", "euclidean_box_slab",
-           "linf_box_slab", "first_reach"]
+           "linf_box_slab", "first_reach", "CentreGrid", "ball_pairs"]
 
 _EPS = float(np.finfo(np.float64).eps)
 _INF = math.inf
@@ -401,3 +401,78 @@ def shell_pairs(euclidean, p, w, pt, lo, hi, box, lower, reach, parents, g, s_lo
     for k in range(pt.size):
         if keep[k]:
             alive[pt[k]] = True
+
+
+class CentreGrid:
+    """Box centres bucketed in a uniform grid of cells (``cell`` at least the boxes'
+    largest side), sorted by cell, for :func:`ball_pairs`: the boxes whose centre
+    lies within a ball, found by scanning the cells the ball's bounding cube meets
+    (a binary search per column of cells), in compiled code."""
+
+    def __init__(self, centres: np.ndarray, cell: float):
+        self.centres = np.ascontiguousarray(centres, dtype=np.float64)      # (m, 3)
+        self.origin = self.centres.min(axis=0) if len(centres) else np.zeros(3)
+        self.cell = float(cell) if cell > 0 else 1.0
+        index = np.floor((self.centres - self.origin) / self.cell).astype(np.int64)
+        self.dims = index.max(axis=0) + 1 if len(centres) else np.ones(3, dtype=np.int64)
+        key = (index[:, 0] * self.dims[1] + index[:, 1]) * self.dims[2] + index[:, 2]
+        self.order = np.argsort(key, kind="stable")
+        self.keys = key[self.order]
+
+    def pairs(self, p: np.ndarray, radius: np.ndarray, counts: np.ndarray = None):
+        """``counts`` (n,) of boxes whose centre is within ``radius`` of each point ``p``
+        (n, 3) (squared distances compared with a relative slack of 1e-12, so rounding
+        only adds boxes); with ``counts`` given, the pairs ``(point, box)``, point by
+        point."""
+        n = len(p)
+        fill = counts is not None
+        total = int(counts.sum()) if fill else 0
+        out_counts = np.zeros(n, dtype=np.int64)
+        pt = np.empty(total, dtype=np.int64)
+        box = np.empty(total, dtype=np.int64)
+        ball_pairs(self.keys, self.order, self.centres, self.origin, self.cell, self.dims,
+                   np.ascontiguousarray(p, dtype=np.float64),
+                   np.ascontiguousarray(radius, dtype=np.float64), fill, out_counts, pt, box)
+        return (pt, box) if fill else out_counts
+
+
+@njit(**COMPILE)
+def ball_pairs(keys, order, centres, origin, cell, dims, p, radius, fill, counts, pt, box):
+    """:meth:`CentreGrid.pairs` in compiled code: per point, ``counts[i]`` boxes, and
+    where ``fill``, their pairs written in order of the points."""
+    k = 0
+    lo_c = np.empty(3, dtype=np.int64)
+    hi_c = np.empty(3, dtype=np.int64)
+    for i in range(p.shape[0]):
+        r = radius[i]
+        r2 = r * r * (1.0 + 1e-12)
+        empty = not (r >= 0.0)
+        for j in range(3):
+            a = math.floor((p[i, j] - r - origin[j]) / cell)
+            b = math.floor((p[i, j] + r - origin[j]) / cell)
+            if not (a <= b) or b < 0 or a > dims[j] - 1:
+                empty = True
+                break
+            lo_c[j] = max(int(a), 0)
+            hi_c[j] = min(int(b), dims[j] - 1)
+        if empty:
+            continue
+        found = 0
+        for ix in range(lo_c[0], hi_c[0] + 1):
+            for iy in range(lo_c[1], hi_c[1] + 1):
+                column = (ix * dims[1] + iy) * dims[2]
+                first = np.searchsorted(keys, column + lo_c[2])
+                last = np.searchsorted(keys, column + hi_c[2], side="right")
+                for m in range(first, last):
+                    b = order[m]
+                    d2 = 0.0
+                    for j in range(3):
+                        d = centres[b, j] - p[i, j]
+                        d2 += d * d
+                    if d2 <= r2:
+                        found += 1
+                        if fill:
+                            pt[k] = i
+                            box[k] = b
+                            k += 1
+        counts[i] = found

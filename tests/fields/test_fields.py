@@ -477,3 +477,28 @@ def test_the_default_grid_reaches_past_the_surface_by_the_band_and_the_isosurfac
     edges = surface.extract_feature_edges(boundary_edges=True, non_manifold_edges=False,
                                           feature_edges=False, manifold_edges=False)
     assert edges.n_cells == 0, f"{edges.n_cells} boundary edges"
+
+
+def test_centre_grid_finds_the_boxes_a_kd_tree_finds():
+    """The certified search's initial pairs (certified_kernels.CentreGrid): every box
+    whose centre is within each point's radius, as scipy's cKDTree finds them (the
+    grid's slack of 1e-12 may only add boxes at the rim), point by point."""
+    from scipy.spatial import cKDTree
+    from implicitvox.fields.certified_kernels import CentreGrid
+    rng = np.random.default_rng(11)
+    centres = np.round(rng.uniform(-2, 2, (5000, 3)) * 16) / 16        # voxel centres
+    points = rng.uniform(-2.5, 2.5, (400, 3))
+    radius = rng.uniform(0.0, 0.6, 400)
+    radius[:5] = [0.0, -1.0, np.inf * 0, 10.0, 0.3]       # none, none, NaN: none, all, some
+    grid = CentreGrid(centres, 1 / 16)
+    counts = grid.pairs(points, radius)
+    pt, box = grid.pairs(points, radius, counts)
+    tree = cKDTree(centres)
+    for i in range(len(points)):
+        want = set(tree.query_ball_point(points[i], radius[i])) if radius[i] >= 0 else set()
+        got = set(box[pt == i].tolist())
+        assert got >= want and counts[i] == len(got)
+        extra = got - want
+        d = np.linalg.norm(centres[list(extra)] - points[i], axis=1) if extra else np.zeros(0)
+        assert np.all(d <= radius[i] * (1 + 1e-12))
+    assert np.all(np.diff(pt) >= 0) and counts[3] == len(centres)
