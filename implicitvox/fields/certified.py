@@ -71,8 +71,6 @@ _NEWTON = 8
 _MARGIN = 2.0 ** -40
 #: points from which Newton estimates come from the array evaluator
 _ARRAY_ESTIMATES = 256
-#: the 8 children of a box: per child, which axes take the upper half
-_CORNERS = np.array(list(np.ndindex(2, 2, 2)), dtype=bool)          # (8, 3)
 
 
 class _Enclosures:
@@ -451,19 +449,22 @@ _NO_PARENT = (np.empty((3, 0)), np.empty(0), np.empty(0), np.empty(0, dtype=bool
 def _kept_boxes(pt, box, lo, hi):
     """The pairs ``(pt, box)`` on a box table holding only the boxes they name (and
     which of the old ones those are)."""
-    used = np.zeros(lo.shape[1], dtype=bool)
-    used[box] = True
-    index = np.cumsum(used) - 1
-    return pt, index[box], lo[:, used], hi[:, used], used
+    from . import certified_kernels as kernels
+    index = np.full(lo.shape[1], -1, dtype=np.int64)
+    count = kernels.number_boxes(box, index)
+    new_box = np.empty_like(box)
+    new_lo, new_hi = np.empty((3, count)), np.empty((3, count))
+    kernels.gather_boxes(box, index, lo, hi, new_box, new_lo, new_hi)
+    return pt, new_box, new_lo, new_hi, index >= 0
 
 
 def _split(pt, box, lo, hi):
     """Each box that still has pairs into its 8 children (box ``k`` of those kept
     becomes boxes ``8k .. 8k + 7``), each pair into 8; and which boxes were kept."""
+    from . import certified_kernels as kernels
     pt, box, ulo, uhi, used = _kept_boxes(pt, box, lo, hi)
-    mid = 0.5 * (ulo + uhi)
-    upper_half = _CORNERS.T[:, None, :]                                 # (3, 1, 8)
-    clo = np.where(upper_half, mid[:, :, None], ulo[:, :, None]).reshape(3, -1)
-    chi = np.where(upper_half, uhi[:, :, None], mid[:, :, None]).reshape(3, -1)
-    children = (box[:, None] * 8 + np.arange(8)[None]).reshape(-1)
-    return np.repeat(pt, 8), children, clo, chi, used
+    m, n = ulo.shape[1], len(pt)
+    child_lo, child_hi = np.empty((3, 8 * m)), np.empty((3, 8 * m))
+    child_pt, child_box = np.empty(8 * n, dtype=np.int64), np.empty(8 * n, dtype=np.int64)
+    kernels.split_boxes(pt, box, ulo, uhi, child_pt, child_box, child_lo, child_hi)
+    return child_pt, child_box, child_lo, child_hi, used

@@ -35,7 +35,8 @@ from numba import njit
 from ..interval.rules import COMPILE
 
 __all__ = ["box_slabs", "pair_bounds", "settle_pairs", "shell_pairs", "euclidean_box_slab",
-           "linf_box_slab", "first_reach", "CentreGrid", "ball_pairs"]
+           "linf_box_slab", "first_reach", "CentreGrid", "ball_pairs", "number_boxes",
+           "gather_boxes", "split_boxes"]
 
 _EPS = float(np.finfo(np.float64).eps)
 _INF = math.inf
@@ -476,3 +477,49 @@ def ball_pairs(keys, order, centres, origin, cell, dims, p, radius, fill, counts
                             box[k] = b
                             k += 1
         counts[i] = found
+
+
+@njit(**COMPILE)
+def number_boxes(box, index):
+    """``index[b]``: box ``b``'s number among the boxes ``box`` names, in order of
+    ``b`` (-1 for the others; ``index`` must hold -1 on entry); returns their count."""
+    for k in range(box.size):
+        index[box[k]] = 0
+    count = 0
+    for b in range(index.size):
+        if index[b] == 0:
+            index[b] = count
+            count += 1
+    return count
+
+
+@njit(**COMPILE)
+def gather_boxes(box, index, lo, hi, new_box, new_lo, new_hi):
+    """The pairs' boxes renumbered by ``index`` (:func:`number_boxes`) into
+    ``new_box``, and the numbered boxes' corners into ``new_lo, new_hi`` (3, count)."""
+    for b in range(index.size):
+        j = index[b]
+        if j >= 0:
+            for a in range(3):
+                new_lo[a, j] = lo[a, b]
+                new_hi[a, j] = hi[a, b]
+    for k in range(box.size):
+        new_box[k] = index[box[k]]
+
+
+@njit(**COMPILE)
+def split_boxes(pt, box, lo, hi, child_pt, child_box, child_lo, child_hi):
+    """Each box ``j`` of ``lo, hi`` (3, m) into its 8 children ``8j .. 8j + 7`` (child
+    ``c`` takes the upper half along axis ``a`` where bit ``2 - a`` of ``c`` is set),
+    and each pair ``(pt[k], box[k])`` into the 8 pairs of its box's children."""
+    for j in range(lo.shape[1]):
+        for a in range(3):
+            mid = 0.5 * (lo[a, j] + hi[a, j])
+            for c in range(8):
+                upper = (c >> (2 - a)) & 1
+                child_lo[a, 8 * j + c] = mid if upper else lo[a, j]
+                child_hi[a, 8 * j + c] = hi[a, j] if upper else mid
+    for k in range(pt.size):
+        for c in range(8):
+            child_pt[8 * k + c] = pt[k]
+            child_box[8 * k + c] = 8 * box[k] + c
