@@ -41,10 +41,12 @@ True
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import numpy as np
 from numba import njit
 
+from . import numba_cache
 from .rounding import COS_ULPS, EPS, LIMITS, POW_ULPS, SIN_ULPS, TRANSCENDENTAL_ULPS
 
 __all__ = [
@@ -71,6 +73,9 @@ def _cache_available() -> bool:
         return False
     return True
 
+
+# the cached kernels compiled from other sources than these are deleted first
+numba_cache.refresh(Path(__file__).resolve().parents[1])
 
 #: how every compiled function of the kernel is compiled: cached on disk where
 #: Numba finds a writable place (else compiled in memory on every first use),
