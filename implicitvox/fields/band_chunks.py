@@ -24,7 +24,7 @@ from ..octree.grid import Grid
 from ..octree.run import Run
 from ..parallel import Job, farm
 from .bricks import masked_coords
-from .certified import certified_distances
+from .certified import SurfaceBoxes, certified_distances
 from .distance_kernels import Kernel, choose_kernel
 from .mesh_band import mesh_band
 
@@ -64,13 +64,19 @@ class DistanceKernel:
         """:func:`~implicitvox.fields.distance_kernels.choose_kernel`'s kernel for the target."""
         return choose_kernel(self.target, self.norm, self._certify)
 
+    @functools.cached_property
+    def surface(self) -> SurfaceBoxes:
+        """:attr:`boxes` indexed for the certified search, once where the kernel runs."""
+        return SurfaceBoxes(*self.boxes)
+
     def _certify(self, points: np.ndarray, weights: Any):
         func = _compiled(self)
-        return certified_distances(func, points, self.norm, weights, self.boxes[0],
-                                   self.boxes[1], limit=self.limit, tolerance=self.tolerance)
+        return certified_distances(func, points, self.norm, weights, self.surface,
+                                   limit=self.limit, tolerance=self.tolerance)
 
     def __getstate__(self) -> dict:
-        return {k: v for k, v in self.__dict__.items() if k not in ("kernel", "function")}
+        return {k: v for k, v in self.__dict__.items()
+                if k not in ("kernel", "function", "surface")}
 
 
 def _compiled(spec: DistanceKernel) -> Function:

@@ -42,7 +42,7 @@ Examples
 >>> f = iv.compile(x * x + y * y + z * z - 1)        # not a distance: needs certifying
 >>> lo, hi = np.array([[0.9, -0.1, -0.1]]), np.array([[1.1, 0.1, 0.1]])
 >>> value, error = certified_distances(f, np.array([[1.2, 0.0, 0.0]]), "euclidean", None,
-...                                    lo, hi, limit=1.0, tolerance=1e-9)
+...                                    SurfaceBoxes(lo, hi), limit=1.0, tolerance=1e-9)
 >>> bool(abs(value[0] - 0.2) <= error[0] <= 1e-9)
 True
 """
@@ -59,7 +59,7 @@ from ..eval.mean_value import array_interval_gradients
 from ..eval.point import evaluate_points
 from ..eval.tape import Tape
 
-__all__ = ["certified_distances", "MAX_LEVELS", "MAX_PAIRS"]
+__all__ = ["certified_distances", "SurfaceBoxes", "MAX_LEVELS", "MAX_PAIRS"]
 
 #: box halvings below the voxels at most
 MAX_LEVELS = 14
@@ -71,6 +71,39 @@ _NEWTON = 8
 _MARGIN = 2.0 ** -40
 #: points from which Newton estimates come from the array evaluator
 _ARRAY_ESTIMATES = 256
+
+
+class SurfaceBoxes:
+    """The boxes whose union holds the surface (the voxelizer's surface voxels),
+    indexed once for every call of :func:`certified_distances` on them: their
+    corners, largest half-diagonal and side, extent, and their centres bucketed
+    for the search's first pairs (:class:`~implicitvox.fields.certified_kernels.CentreGrid`;
+    building it costs about as much as certifying a few hundred samples).
+
+    Parameters
+    ----------
+    lo, hi : ndarray (m, 3)
+        The boxes' corners.
+    """
+
+    def __init__(self, lo: np.ndarray, hi: np.ndarray):
+        from . import certified_kernels                          # (load Numba)
+        self.lo = np.asarray(lo, dtype=np.float64).reshape(-1, 3)
+        self.hi = np.asarray(hi, dtype=np.float64).reshape(-1, 3)
+        m = len(self.lo)
+        #: the largest half-diagonal and side of a box
+        self.half_diag = float(np.max(np.linalg.norm(self.hi - self.lo, axis=1))) / 2 if m \
+            else 0.0
+        self.scale = float(np.max(self.hi - self.lo)) if m else 1.0
+        #: the corners of their bounding box
+        self.low = self.lo.min(axis=0) if m else np.zeros(3)
+        self.high = self.hi.max(axis=0) if m else np.zeros(3)
+        # (cells of 4 boxes: the balls reach a few boxes, so a few columns of cells each)
+        self.centres = certified_kernels.CentreGrid(0.5 * (self.lo + self.hi),
+                                                    4.0 * self.scale) if m else None
+
+    def __len__(self) -> int:
+        return len(self.lo)
 
 
 class _Enclosures:
@@ -236,7 +269,7 @@ def _newton_upper(ev: _Enclosures, euclidean: bool, p: np.ndarray, w: np.ndarray
 
 
 def certified_distances(func: Function, points: np.ndarray, norm: str, weights: Optional[Any],
-                        boxes_lo: np.ndarray, boxes_hi: np.ndarray, *, limit: float,
+                        boxes: SurfaceBoxes, *, limit: float,
                         tolerance: float, max_levels: int = MAX_LEVELS,
                         progress: Optional[Callable[[float], Any]] = None,
                         stats: Optional[dict] = None) -> tuple[np.ndarray, np.ndarray]:
@@ -250,9 +283,9 @@ def certified_distances(func: Function, points: np.ndarray, norm: str, weights: 
     norm : {"euclidean", "linf"}
     weights : None or array (3,) or (n, 3)
         Per-axis weights of the max-norm (ignored for the Euclidean norm).
-    boxes_lo, boxes_hi : ndarray (m, 3)
+    boxes : SurfaceBoxes
         Boxes whose union holds every surface point within ``limit`` of a point
-        (the voxelizer's surface voxels).
+        (the voxelizer's surface voxels), indexed once for all calls.
     limit : float
         Where to look first: the pairs are the boxes within ``limit`` (or the
         point's Newton bound); a point with no zero proved within it is searched
@@ -281,16 +314,8 @@ def certified_distances(func: Function, points: np.ndarray, norm: str, weights: 
     if n == 0:
         return value, error
     ev = _Enclosures(func.tape)
-    boxes_lo = np.asarray(boxes_lo, dtype=np.float64)
-    boxes_hi = np.asarray(boxes_hi, dtype=np.float64)
-    half_diag = float(np.max(np.linalg.norm(boxes_hi - boxes_lo, axis=1))) / 2 if len(boxes_lo) \
-        else 0.0
-    scale = float(np.max(boxes_hi - boxes_lo)) if len(boxes_lo) else 1.0
-    # (cells of 4 boxes: the balls reach a few boxes, so a few columns of cells each)
-    centres = ev.kernels.CentreGrid(0.5 * (boxes_lo + boxes_hi), 4.0 * scale) \
-        if len(boxes_lo) else None
-    span = np.concatenate([boxes_hi, p]).max(axis=0) - np.concatenate([boxes_lo, p]).min(axis=0) \
-        if len(boxes_lo) else np.zeros(3)
+    span = np.maximum(boxes.high, p.max(axis=0)) - np.minimum(boxes.low, p.min(axis=0)) \
+        if len(boxes) else np.zeros(3)
     max_reach = max(limit, float(np.max(span / (1.0 if euclidean else np.min(w)))) * 2.0)
     sign = _point_signs(ev, p)
     # the gap U - L at which a point's error, with _bracket's outward margins (at
@@ -304,8 +329,8 @@ def certified_distances(func: Function, points: np.ndarray, norm: str, weights: 
         rows = np.arange(s, min(s + _BLOCK, n))
         reach = limit
         while len(rows):
-            lo_b, up_b = _bracket(ev, euclidean, p[rows], w[rows], centres, boxes_lo, boxes_hi,
-                                  half_diag, scale, reach, gap, max_levels, stats)
+            lo_b, up_b = _bracket(ev, euclidean, p[rows], w[rows], boxes, reach, gap,
+                                  max_levels, stats)
             value[rows] = 0.5 * (lo_b + up_b)
             error[rows] = 0.5 * (up_b - lo_b)
             # no zero proved within reach: search farther (all the boxes at the end)
@@ -329,32 +354,32 @@ def _point_signs(ev: _Enclosures, p: np.ndarray) -> np.ndarray:
     return np.where(proved != 0, proved, np.where(v < 0, -1.0, 1.0)).astype(np.float64)
 
 
-def _bracket(ev, euclidean, p, w, centres, boxes_lo, boxes_hi, half_diag, scale, limit,
-             gap, max_levels, stats):
+def _bracket(ev, euclidean, p, w, boxes, limit, gap, max_levels, stats):
     """``(L, U)`` for one block of points (see the module docstring)."""
     n = len(p)
+    centres = boxes.centres
     if centres is None:                    # no box may hold the surface: none within reach
         return np.full(n, limit), np.full(n, np.inf)
-    upper = _newton_upper(ev, euclidean, p, w, scale)
+    upper = _newton_upper(ev, euclidean, p, w, boxes.scale)
     # the initial pairs: boxes whose centre is within reach (a superset, then exact),
     # gathered for groups of points with at most MAX_PAIRS pairs between them
     reach = np.minimum(upper, limit)
-    euclid_reach = reach * (1.0 if euclidean else np.sqrt(3) * float(np.max(w))) + half_diag
+    euclid_reach = reach * (1.0 if euclidean else np.sqrt(3) * float(np.max(w))) + \
+        boxes.half_diag
     counts = centres.pairs(p, euclid_reach)
     lower = np.where(counts == 0, reach, 0.0)     # no box within reach: nothing nearer
     state = {"upper": upper, "lower": lower, "open": counts > 0, "parked": np.full(n, np.inf),
              # the domain the boxes cover (their bounding box): a nearest zero inside it
              # meets the Fritz John condition (certified_kernels.pair_bounds)
-             "interior_lo": boxes_lo.min(axis=0), "interior_hi": boxes_hi.max(axis=0)}
+             "interior_lo": boxes.low, "interior_hi": boxes.high}
     group = np.cumsum(counts) // MAX_PAIRS
     for g in np.unique(group[counts > 0]):
         rows = np.flatnonzero((group == g) & (counts > 0))
         pt, box = centres.pairs(p[rows], euclid_reach[rows], counts[rows])
         used, box = np.unique(box, return_inverse=True)
         pt = rows[pt]
-        _refine(ev, euclidean, p, w, pt, box.reshape(-1), np.ascontiguousarray(boxes_lo[used].T),
-                np.ascontiguousarray(boxes_hi[used].T), 0, state, limit, gap, max_levels,
-                stats)
+        _refine(ev, euclidean, p, w, pt, box.reshape(-1), np.ascontiguousarray(boxes.lo[used].T),
+                np.ascontiguousarray(boxes.hi[used].T), 0, state, limit, gap, max_levels, stats)
     lower, upper = state["lower"], state["upper"]
     # outward: a relative margin, and one for the roundings of coordinates of this size
     slack = _MARGIN * (1.0 + float(np.max(np.abs(p))))
