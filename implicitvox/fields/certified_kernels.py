@@ -28,6 +28,7 @@ Examples
 from __future__ import annotations
 
 import math
+from typing import Optional
 
 import numpy as np
 from numba import njit
@@ -420,7 +421,7 @@ class CentreGrid:
         self.order = np.argsort(key, kind="stable")
         self.keys = key[self.order]
 
-    def pairs(self, p: np.ndarray, radius: np.ndarray, counts: np.ndarray = None):
+    def pairs(self, p: np.ndarray, radius: np.ndarray, counts: Optional[np.ndarray] = None):
         """``counts`` (n,) of boxes whose centre is within ``radius`` of each point ``p``
         (n, 3) (squared distances compared with a relative slack of 1e-12, so rounding
         only adds boxes); with ``counts`` given, the pairs ``(point, box)``, point by
